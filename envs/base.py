@@ -1,0 +1,94 @@
+"""The contract every goal-conditioned task speaks, so SPLID can save, restore and replay it.
+
+A task is a frozen dataclass (hashable, so jitted code may close over it) whose methods are pure:
+``reset(key) -> State``, ``step(state, action) -> State``, ``with_goal(state, goal) -> State``.
+``State.physics`` holds everything the future of the episode depends on, so a ``State`` saved
+during exploration *is* the snapshot SELECT restores.
+"""
+
+from __future__ import annotations
+
+import abc
+import dataclasses
+from typing import Any
+
+import jax
+import jax.numpy as jnp
+from flax import struct
+
+
+class InvalidConfig(ValueError):
+    """A configuration value is out of its allowed range; the message names field and range."""
+
+    def __init__(self, field: str, value: Any, allowed: str):
+        self.field = field
+        self.value = value
+        self.allowed = allowed
+        super().__init__(f"invalid {field}={value!r}: must be {allowed}")
+
+
+def check(ok: bool, field: str, value: Any, allowed: str) -> None:
+    """Raise ``InvalidConfig`` naming ``field`` unless ``ok``."""
+    if not ok:
+        raise InvalidConfig(field, value, allowed)
+
+
+@struct.dataclass
+class State:
+    """One step of one episode; batch it with ``jax.vmap``."""
+
+    physics: Any  # task-specific pytree: the complete simulator state
+    obs: jax.Array  # [obs_size]
+    achieved_goal: jax.Array  # [goal_size]
+    desired_goal: jax.Array  # [goal_size]
+    reward: jax.Array  # [] float32, sparse
+    success: jax.Array  # [] bool, achieved within the threshold of desired
+    step: jax.Array  # [] int32, control steps taken in this episode
+    invalid: jax.Array  # [] bool, a NaN was seen: the episode is flagged, never silently used
+
+
+@dataclasses.dataclass(frozen=True)
+class GoalEnv(abc.ABC):
+    """Base for tasks. Subclasses are frozen dataclasses whose fields are the task's options."""
+
+    @property
+    @abc.abstractmethod
+    def obs_size(self) -> int: ...
+
+    @property
+    @abc.abstractmethod
+    def goal_size(self) -> int: ...
+
+    @property
+    @abc.abstractmethod
+    def action_size(self) -> int: ...
+
+    @property
+    @abc.abstractmethod
+    def episode_length(self) -> int: ...
+
+    @abc.abstractmethod
+    def reset(self, key: jax.Array) -> State: ...
+
+    @abc.abstractmethod
+    def step(self, state: State, action: jax.Array) -> State:
+        """Advance one control step; actions are clipped to [-1, 1]."""
+
+    @abc.abstractmethod
+    def with_goal(self, state: State, goal: jax.Array) -> State:
+        """The same simulator state pursuing ``goal``: what SELECT restores."""
+
+    @abc.abstractmethod
+    def success(self, achieved: jax.Array, desired: jax.Array) -> jax.Array:
+        """Whether ``achieved`` is within the task's threshold of ``desired`` (broadcasts)."""
+
+    def reward_of(self, achieved: jax.Array, desired: jax.Array) -> jax.Array:
+        """Sparse reward; the Fetch convention -(not success). Tasks may override."""
+        return self.success(achieved, desired).astype(jnp.float32) - 1.0
+
+
+def flag_invalid(state: State) -> State:
+    """Set ``invalid`` when any float in the state is NaN; stays set for the episode."""
+    leaves = [x for x in jax.tree_util.tree_leaves(state) if jnp.issubdtype(x.dtype, jnp.floating)]
+    bad = jnp.any(jnp.stack([jnp.any(jnp.isnan(x)) for x in leaves]))
+    return state.replace(invalid=state.invalid | bad)

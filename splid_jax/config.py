@@ -1,0 +1,108 @@
+"""The training configuration: one frozen dataclass, validated on construction, from which the
+command line is generated (each field's ``help`` is its ``--help`` line)."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from typing import Any
+
+import envs
+from envs.base import check
+
+
+def _f(default, help: str, **kw):
+    return dataclasses.field(default=default, metadata={"help": help, **kw})
+
+
+@dataclasses.dataclass(frozen=True)
+class TrainConfig:
+    env: str = _f("point", "task: " + ", ".join(envs.names()))
+    seed: int = _f(0, "PRNG seed; the same seed on the same device gives the same run")
+    iterations: int = _f(None, "SPLID iterations (explore, select, behaviour cloning); a multiple of eval_every")
+    num_envs: int = _f(None, "episodes explored in parallel per iteration")
+    sigma: float = _f(1.0, "std of the Gaussian exploration noise added to the policy's action")
+    horizon: int = _f(8, "learning horizon H: hindsight goals come from 1..H steps ahead")
+    select: bool = _f(True, "SELECT by first hit time; --no-select stores every relabelled pair (ablation)")
+    buffer_size: int = _f(None, "relabel buffer capacity (FIFO)")
+    batch_size: int = _f(None, "behaviour-cloning minibatch size")
+    bc_steps: int = _f(None, "behaviour-cloning gradient steps per iteration")
+    learning_rate: float = _f(None, "Adam learning rate of the behaviour-cloning step")
+    hidden: tuple[int, ...] = _f(None, "hidden layer widths of the policy MLP, e.g. 64,64,64")
+    normalise: bool = _f(True, "normalise policy inputs with running mean and std")
+    eval_every: int = _f(None, "iterations per compiled chunk; evaluation, logging and checkpoints come between")
+    eval_episodes: int = _f(None, "episodes of the deterministic policy per evaluation")
+    checkpoint_every: int = _f(1, "chunks between checkpoints (0: only at the end)")
+    run_dir: str | None = _f(None, "directory for config.json, metrics.jsonl and checkpoints (default runs/ENV-sSEED)")
+
+    def __post_init__(self):
+        check(self.env in envs.names(), "env", self.env, "one of " + ", ".join(envs.names()))
+        defaults = TASK_DEFAULTS[self.env]
+        for name, value in defaults.items():  # fill per-task defaults for fields left at None
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, value)
+        object.__setattr__(self, "hidden", tuple(int(w) for w in self.hidden))
+        check(self.iterations >= 1, "iterations", self.iterations, "an integer >= 1")
+        check(self.num_envs >= 1, "num_envs", self.num_envs, "an integer >= 1")
+        check(self.sigma >= 0, "sigma", self.sigma, ">= 0")
+        check(self.horizon >= 1, "horizon", self.horizon, "an integer >= 1 (and < the episode length)")
+        check(self.buffer_size >= 1, "buffer_size", self.buffer_size, "an integer >= 1")
+        check(self.batch_size >= 1, "batch_size", self.batch_size, "an integer >= 1")
+        check(self.bc_steps >= 0, "bc_steps", self.bc_steps, "an integer >= 0")
+        check(self.learning_rate > 0, "learning_rate", self.learning_rate, "> 0")
+        check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "hidden", self.hidden, "one or more widths >= 1")
+        check(self.eval_every >= 1, "eval_every", self.eval_every, "an integer >= 1")
+        check(
+            self.iterations % self.eval_every == 0,
+            "iterations",
+            self.iterations,
+            f"a multiple of eval_every={self.eval_every}",
+        )
+        check(self.eval_episodes >= 1, "eval_episodes", self.eval_episodes, "an integer >= 1")
+        check(self.checkpoint_every >= 0, "checkpoint_every", self.checkpoint_every, "an integer >= 0")
+        if self.run_dir is None:
+            object.__setattr__(self, "run_dir", os.path.join("runs", f"{self.env}-s{self.seed}"))
+        check(not os.path.isfile(self.run_dir), "run_dir", self.run_dir, "a directory, not an existing file")
+
+    def check_env(self, env: envs.GoalEnv) -> None:
+        """Checks that need the task's sizes."""
+        check(
+            self.horizon < env.episode_length,
+            "horizon",
+            self.horizon,
+            f"an integer in [1, {env.episode_length - 1}] (below the episode length)",
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+
+_POINT = dict(
+    iterations=60,
+    num_envs=32,
+    buffer_size=200_000,
+    batch_size=256,
+    bc_steps=100,
+    learning_rate=1e-3,
+    hidden=(64, 64, 64),
+    eval_every=5,
+    eval_episodes=200,
+)
+_FETCH = dict(
+    iterations=200,
+    num_envs=256,
+    buffer_size=1_000_000,
+    batch_size=1024,
+    bc_steps=200,
+    learning_rate=1e-3,
+    hidden=(256, 256, 256),
+    eval_every=5,
+    eval_episodes=500,
+)
+TASK_DEFAULTS: dict[str, dict[str, Any]] = {
+    "point": _POINT,
+    "reach": {**_FETCH, "iterations": 20, "num_envs": 64},
+    "push": _FETCH,
+    "slide": _FETCH,
+    "pick_and_place": _FETCH,
+}

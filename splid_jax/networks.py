@@ -1,0 +1,77 @@
+"""The deterministic goal-conditioned policy pi_theta(s, g) and its input normaliser."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+from collections.abc import Sequence
+
+import flax.linen as nn
+import jax
+import jax.numpy as jnp
+from flax import struct
+
+with contextlib.redirect_stdout(io.StringIO()):  # brax imports MJX, which prints a warp notice
+    from brax.training.acme import running_statistics
+
+CLIP_NORMALISED = 5.0  # normalised inputs are clipped here, as HER does, so outliers cannot dominate
+
+
+class MLP(nn.Module):
+    """Leaky-ReLU MLP with orthogonal init (as the reference code), linear mean output."""
+
+    hidden: Sequence[int]
+    action_size: int
+
+    @nn.compact
+    def __call__(self, x: jax.Array) -> jax.Array:
+        for width in self.hidden:
+            x = nn.leaky_relu(nn.Dense(width, kernel_init=nn.initializers.orthogonal(jnp.sqrt(2.0)))(x))
+        return nn.Dense(self.action_size, kernel_init=nn.initializers.orthogonal(0.01))(x)
+
+
+@struct.dataclass
+class PolicyState:
+    params: dict
+    normaliser: running_statistics.RunningStatisticsState
+
+
+@struct.dataclass
+class Policy:
+    """Pure functions around the MLP; static, so jitted code may close over it."""
+
+    net: MLP = struct.field(pytree_node=False)
+    in_size: int = struct.field(pytree_node=False)
+    normalise: bool = struct.field(pytree_node=False, default=True)
+
+    def init(self, key: jax.Array) -> PolicyState:
+        params = self.net.init(key, jnp.zeros((self.in_size,)))
+        normaliser = running_statistics.init_state(jnp.zeros((self.in_size,), jnp.float32))
+        return PolicyState(params=params, normaliser=normaliser)
+
+    def _inputs(self, pstate: PolicyState, obs: jax.Array, goal: jax.Array) -> jax.Array:
+        x = jnp.concatenate([obs, goal], axis=-1)
+        if self.normalise:
+            x = running_statistics.normalize(x, pstate.normaliser, max_abs_value=CLIP_NORMALISED)
+        return x
+
+    def mean(self, pstate: PolicyState, obs: jax.Array, goal: jax.Array, params=None) -> jax.Array:
+        """Unclipped network output; ``params`` overrides the stored ones (for gradients)."""
+        params = pstate.params if params is None else params
+        return self.net.apply(params, self._inputs(pstate, obs, goal))
+
+    def act(self, pstate: PolicyState, obs: jax.Array, goal: jax.Array) -> jax.Array:
+        """The deterministic action the environment receives."""
+        return jnp.clip(self.mean(pstate, obs, goal), -1.0, 1.0)
+
+    def update_normaliser(self, pstate: PolicyState, obs: jax.Array, goal: jax.Array) -> PolicyState:
+        if not self.normalise:
+            return pstate
+        x = jnp.concatenate([obs, goal], axis=-1).reshape(-1, self.in_size)
+        return pstate.replace(normaliser=running_statistics.update(pstate.normaliser, x))
+
+
+def make_policy(obs_size: int, goal_size: int, action_size: int, hidden: Sequence[int], normalise: bool) -> Policy:
+    return Policy(
+        net=MLP(hidden=tuple(hidden), action_size=action_size), in_size=obs_size + goal_size, normalise=normalise
+    )

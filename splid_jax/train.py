@@ -1,0 +1,200 @@
+"""``python -m splid_jax.train --env ENV``: train SPLID, log, checkpoint, resume.
+
+Python runs only between compiled chunks: it logs, writes metrics.jsonl and saves checkpoints."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import dataclasses
+import io
+import json
+import os
+import sys
+import time
+
+import jax
+import numpy as np
+
+import envs
+from envs.base import InvalidConfig
+from splid_jax import checkpoint, progress
+from splid_jax.cli import add_config_flags, explicit_values
+from splid_jax.config import TASK_DEFAULTS, TrainConfig
+from splid_jax.trainer import Trainer
+
+# Fields a resumed run must share with its checkpoint; the rest may change on resume.
+_MAY_CHANGE_ON_RESUME = {"iterations", "run_dir", "checkpoint_every"}
+
+
+class RunStopped(RuntimeError):
+    """The run stopped early for a reason the user must see (NaN); exit code 3."""
+
+
+def make_env(name: str, **overrides) -> envs.GoalEnv:
+    with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
+        return envs.make(name, **overrides)
+
+
+def _identity(cfg: TrainConfig) -> dict:
+    return {k: v for k, v in cfg.to_json().items() if k not in _MAY_CHANGE_ON_RESUME}
+
+
+def _record(trainer: Trainer, metrics: dict, wall_s: float, chunk_s: float, iteration: int) -> dict:
+    rec = trainer.counters(iteration)
+    for k, v in metrics.items():
+        rec[k] = v.item()
+    steps = trainer.cfg.eval_every * (trainer.counters(1)["env_steps"] + trainer.counters(1)["select_steps"])
+    rec["buffer_fill"] = rec["buffer_size"] / trainer.cfg.buffer_size
+    rec["steps_per_s"] = steps / max(chunk_s, 1e-9)
+    rec["wall_s"] = wall_s
+    return rec
+
+
+def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False, quiet: bool = False) -> dict:
+    """Train to ``cfg.iterations``; returns the last metrics record. Resumes from the newest
+    checkpoint in ``cfg.run_dir`` when ``resume``."""
+    env = env or make_env(cfg.env)
+    trainer = Trainer(env, cfg)
+    os.makedirs(cfg.run_dir, exist_ok=True)
+    metrics_path = os.path.join(cfg.run_dir, "metrics.jsonl")
+    state = trainer.init(jax.random.PRNGKey(cfg.seed))
+    wall_before = 0.0
+    if resume:
+        step, state, meta = checkpoint.restore(cfg.run_dir, state)
+        _check_same_run(meta["config"], _identity(cfg))
+        wall_before = float(meta["wall_s"])
+        kept = [r for r in _read_jsonl(metrics_path) if r["iteration"] <= step]
+        _write_jsonl(metrics_path, kept)
+        progress.show(f"resumed {cfg.run_dir} at iteration {step}", quiet)
+    else:
+        open(metrics_path, "w").close()
+    with open(os.path.join(cfg.run_dir, "config.json"), "w") as fh:
+        json.dump(cfg.to_json(), fh, indent=2)
+
+    hyper = trainer.hyper()
+    iteration = int(state.iteration)
+    progress.show(f"splid_jax: env={cfg.env} select={cfg.select} device={jax.devices()[0].platform}", quiet)
+    progress.show(progress.HEADER, quiet)
+    start = time.perf_counter()
+    rec, chunks_done = {}, 0
+
+    def save(st, it):
+        meta = {"config": _identity(cfg), "wall_s": wall_before + time.perf_counter() - start}
+        checkpoint.save(cfg.run_dir, it, st, meta)
+
+    try:
+        while iteration < cfg.iterations:
+            t0 = time.perf_counter()
+            new_state, metrics = trainer.chunk(state, hyper)
+            metrics = jax.device_get(metrics)
+            chunk_s = time.perf_counter() - t0
+            if not bool(metrics.pop("finite")):
+                raise RunStopped(
+                    f"non-finite loss or parameters after iteration {iteration + cfg.eval_every}; "
+                    f"stopped, the last good checkpoint (iteration {iteration}) is kept in {cfg.run_dir}"
+                )
+            state, iteration, chunks_done = new_state, iteration + cfg.eval_every, chunks_done + 1
+            rec = _record(trainer, metrics, wall_before + time.perf_counter() - start, chunk_s, iteration)
+            with open(metrics_path, "a") as fh:
+                fh.write(json.dumps(rec) + "\n")
+            progress.show(progress.line(rec, cfg.iterations), quiet)
+            if iteration == cfg.iterations or (cfg.checkpoint_every and chunks_done % cfg.checkpoint_every == 0):
+                save(state, iteration)
+    except KeyboardInterrupt:
+        save(state, iteration)
+        progress.show(f"interrupted: saved iteration {iteration} to {cfg.run_dir}; resume with --resume", quiet)
+        raise
+    except RunStopped:
+        if checkpoint.latest_step(cfg.run_dir) != iteration:
+            save(state, iteration)
+        raise
+    return rec
+
+
+def _check_same_run(saved: dict, now: dict) -> None:
+    for k in sorted(set(saved) | set(now)):
+        a, b = saved.get(k), now.get(k)
+        if isinstance(a, list):
+            a = tuple(a)
+        if isinstance(b, list):
+            b = tuple(b)
+        if a != b:
+            raise checkpoint.CheckpointError(f"checkpoint was made with {k}={a!r}, this run has {k}={b!r}")
+
+
+def _read_jsonl(path: str) -> list[dict]:
+    if not os.path.exists(path):
+        return []
+    with open(path) as fh:
+        return [json.loads(line) for line in fh if line.strip()]
+
+
+def _write_jsonl(path: str, records: list[dict]) -> None:
+    with open(path, "w") as fh:
+        fh.writelines(json.dumps(r) + "\n" for r in records)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="python -m splid_jax.train",
+        description="Train SPLID (explore, SELECT by first hit time, behaviour cloning) on a goal-conditioned task.",
+    )
+    add_config_flags(parser, TrainConfig, TASK_DEFAULTS)
+    parser.add_argument("--resume", metavar="RUN_DIR", help="continue the run saved in RUN_DIR (its config.json)")
+    parser.add_argument("--quiet", action="store_true", help="no progress display")
+    return parser
+
+
+def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
+    given = explicit_values(TrainConfig, ns)
+    if ns.resume is None:
+        cfg = TrainConfig(**given)
+        if os.path.isdir(cfg.run_dir) and checkpoint.latest_step(cfg.run_dir) is not None:
+            raise InvalidConfig("run_dir", cfg.run_dir, "a directory without a run in it (or pass --resume RUN_DIR)")
+        return cfg, False
+    path = os.path.join(ns.resume, "config.json")
+    if not os.path.isfile(path):
+        raise InvalidConfig("resume", ns.resume, "a run directory holding config.json")
+    with open(path) as fh:
+        saved = json.load(fh)
+    fields = {f.name for f in dataclasses.fields(TrainConfig)}
+    saved = {k: v for k, v in saved.items() if k in fields}
+    for k, v in given.items():
+        if k not in _MAY_CHANGE_ON_RESUME and v != saved.get(k) and not (isinstance(v, tuple) and list(v) == saved[k]):
+            raise InvalidConfig(k, v, f"{saved.get(k)!r} as in the run being resumed (only iterations may change)")
+    saved.update(given, run_dir=ns.resume)
+    return TrainConfig(**saved), True
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    ns = parser.parse_args(argv)
+    try:
+        cfg, resume = config_from_cli(ns)
+        env = make_env(cfg.env)
+        cfg.check_env(env)
+        if resume and checkpoint.latest_step(cfg.run_dir) is None:
+            raise InvalidConfig("resume", cfg.run_dir, "a run directory holding a checkpoint")
+    except InvalidConfig as err:
+        print(f"{parser.prog}: error: {err}", file=sys.stderr)
+        return 2
+    try:
+        rec = run(cfg, env, resume=resume, quiet=ns.quiet)
+    except KeyboardInterrupt:
+        return 130
+    except (RunStopped, checkpoint.CheckpointError) as err:
+        print(f"{parser.prog}: error: {err}", file=sys.stderr)
+        return 3
+    if rec:
+        progress.show(
+            f"done: {rec['iteration']} iterations, eval success {rec['eval_success']:.3f} "
+            f"(final step {rec['eval_success_final']:.3f}) in {rec['wall_s']:.1f} s; run dir {cfg.run_dir}",
+            ns.quiet,
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    np.set_printoptions(precision=4)
+    raise SystemExit(main())

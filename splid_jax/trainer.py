@@ -1,0 +1,116 @@
+"""Algorithm 2 as one pure, scanned program: ``explore -> select -> insert -> bc`` per
+iteration, ``eval_every`` iterations and one evaluation per compiled chunk."""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import optax
+from flax import struct
+
+from envs.base import GoalEnv
+from splid_jax import relabel_buffer
+from splid_jax.bc import bc_epoch
+from splid_jax.config import TrainConfig
+from splid_jax.evaluate import evaluate
+from splid_jax.explore import explore
+from splid_jax.networks import PolicyState, make_policy
+from splid_jax.select import replay_steps, select
+
+
+@struct.dataclass
+class TrainState:
+    policy: PolicyState
+    opt_state: optax.OptState
+    buffer: relabel_buffer.Buffer
+    key: jax.Array
+    iteration: jax.Array  # [] int32, completed iterations
+
+
+@struct.dataclass
+class Hyper:
+    """Hyper-parameters that may differ between members of one vmapped sweep."""
+
+    sigma: jax.Array  # [] float32
+    horizon: jax.Array  # [] int32, <= the trainer's max_horizon
+
+
+class Trainer:
+    """Holds what is static (task, network, optimiser, shapes); all state flows through arguments."""
+
+    def __init__(self, env: GoalEnv, cfg: TrainConfig, max_horizon: int | None = None):
+        cfg.check_env(env)
+        self.env, self.cfg = env, cfg
+        self.max_horizon = cfg.horizon if max_horizon is None else max_horizon
+        self.policy = make_policy(env.obs_size, env.goal_size, env.action_size, cfg.hidden, cfg.normalise)
+        self.optimiser = optax.adam(cfg.learning_rate)
+        self.traces = 0  # counts compilations of ``chunk``; tests check it stays at one
+        self.chunk = jax.jit(self._chunk)
+
+    def hyper(self, sigma: float | None = None, horizon: int | None = None) -> Hyper:
+        return Hyper(
+            sigma=jnp.float32(self.cfg.sigma if sigma is None else sigma),
+            horizon=jnp.int32(self.cfg.horizon if horizon is None else horizon),
+        )
+
+    def init(self, key: jax.Array) -> TrainState:
+        k_policy, k_run = jax.random.split(key)
+        pstate = self.policy.init(k_policy)
+        env, cfg = self.env, self.cfg
+        return TrainState(
+            policy=pstate,
+            opt_state=self.optimiser.init(pstate.params),
+            buffer=relabel_buffer.init(cfg.buffer_size, env.obs_size, env.goal_size, env.action_size),
+            key=k_run,
+            iteration=jnp.int32(0),
+        )
+
+    def iteration(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
+        env, cfg, policy = self.env, self.cfg, self.policy
+        key, k_explore, k_bc = jax.random.split(ts.key, 3)
+        traj = explore(env, policy, ts.policy, k_explore, cfg.num_envs, hyper.sigma)
+        cands = select(env, policy, ts.policy, traj, self.max_horizon, hyper.horizon, cfg.select)
+        buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
+        pstate = policy.update_normaliser(ts.policy, traj.states.obs, traj.achieved[:-1])
+        pstate, opt_state, loss = bc_epoch(
+            policy, self.optimiser, pstate, ts.opt_state, buf, k_bc, cfg.bc_steps, cfg.batch_size
+        )
+        metrics = {
+            "select_pairs": jnp.sum(cands.valid, dtype=jnp.int32),
+            "select_accepted": jnp.sum(cands.accept, dtype=jnp.int32),
+            "bc_loss": loss,
+            "explore_success": jnp.mean(jnp.any(traj.states.success, axis=0)),
+        }
+        new = TrainState(policy=pstate, opt_state=opt_state, buffer=buf, key=key, iteration=ts.iteration + 1)
+        return new, metrics
+
+    def _chunk(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
+        self.traces += 1
+        ts, per_iter = jax.lax.scan(lambda s, _: self.iteration(s, hyper), ts, None, length=self.cfg.eval_every)
+        key, k_eval = jax.random.split(ts.key)
+        metrics = evaluate(self.env, self.policy, ts.policy, k_eval, self.cfg.eval_episodes)
+        metrics.update(
+            select_pairs=jnp.sum(per_iter["select_pairs"]),
+            select_accepted=jnp.sum(per_iter["select_accepted"]),
+            bc_loss=per_iter["bc_loss"][-1],
+            explore_success=jnp.mean(per_iter["explore_success"]),
+            buffer_size=ts.buffer.size,
+            finite=params_finite(ts.policy.params) & jnp.all(jnp.isfinite(per_iter["bc_loss"])),
+        )
+        return ts.replace(key=key), metrics
+
+    def counters(self, iteration: int, horizon: int | None = None) -> dict:
+        """Work done after ``iteration`` iterations, as exact Python ints (no int32 overflow)."""
+        cfg, T = self.cfg, self.env.episode_length
+        h = cfg.horizon if horizon is None else horizon
+        per_iter = replay_steps(T, h, cfg.num_envs) if cfg.select else 0
+        return {
+            "iteration": iteration,
+            "episodes": iteration * cfg.num_envs,
+            "env_steps": iteration * cfg.num_envs * T,
+            "select_steps": iteration * per_iter,
+        }
+
+
+def params_finite(params) -> jax.Array:
+    return jnp.all(jnp.stack([jnp.all(jnp.isfinite(x)) for x in jax.tree_util.tree_leaves(params)]))
