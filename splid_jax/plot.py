@@ -1,0 +1,261 @@
+"""``python -m splid_jax.plot RUN_DIR [RUN_DIR...]``: learning curves of one or more runs.
+
+Rows: evaluation success (solid: at any step, dashed: at the final step) and evaluation
+return. Columns: episodes, simulator steps and wall-clock seconds. The step axis counts
+SELECT's replay steps as well as exploration steps, so select and no-select runs are
+compared at equal simulation cost.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import sys
+from collections.abc import Sequence
+
+import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg
+
+REQUIRED = (
+    "iteration",
+    "episodes",
+    "env_steps",
+    "select_steps",
+    "eval_success",
+    "eval_success_final",
+    "eval_return",
+    "wall_s",
+)
+# Config keys that never change what a run learns, so they neither label nor split runs.
+_NOT_IDENTITY = {"run_dir", "seed", "checkpoint_every"}
+_X_AXES = (
+    ("episodes", "episodes"),
+    ("sim_steps", "simulator steps (env + SELECT replay)"),
+    ("wall_s", "wall clock (s)"),
+)
+
+
+class PlotError(ValueError):
+    """A run directory cannot be plotted; the message is shown as is, exit code 2."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Run:
+    run_dir: str
+    config: dict
+    columns: dict[str, np.ndarray]  # metric name -> values per evaluation, in iteration order
+
+
+def load_run(run_dir: str) -> Run:
+    if not os.path.isdir(run_dir):
+        raise PlotError(f"{run_dir}: no such run directory")
+    path = os.path.join(run_dir, "metrics.jsonl")
+    if not os.path.isfile(path):
+        raise PlotError(f"{path}: no metrics file")
+    with open(path) as fh:
+        text = fh.read()
+    lines = text.splitlines()
+    records = []
+    for n, line in enumerate(lines, 1):
+        if not line.strip():
+            continue
+        try:
+            records.append(json.loads(line))
+        except json.JSONDecodeError as e:
+            if n == len(lines) and not text.endswith("\n"):
+                break  # the writer was stopped mid-line; every line before it is whole
+            raise PlotError(f"{path}:{n}: not a JSON object ({e.msg})") from e
+    if not records:
+        raise PlotError(f"{path}: no evaluation records yet")
+    for n, rec in enumerate(records, 1):
+        missing = [k for k in REQUIRED if not isinstance(rec, dict) or k not in rec]
+        if missing:
+            raise PlotError(f"{path}: record {n} lacks {', '.join(missing)}")
+    records.sort(key=lambda r: r["iteration"])
+    columns = {k: np.asarray([float(r[k]) for r in records]) for k in REQUIRED}
+    columns["sim_steps"] = columns["env_steps"] + columns["select_steps"]
+
+    config: dict = {}
+    config_path = os.path.join(run_dir, "config.json")
+    if os.path.isfile(config_path):
+        try:
+            with open(config_path) as fh:
+                loaded = json.load(fh)
+            config = loaded if isinstance(loaded, dict) else {}
+        except json.JSONDecodeError:
+            config = {}  # the label falls back to the directory name
+    return Run(run_dir, config, columns)
+
+
+def _dir_name(run: Run) -> str:
+    return os.path.basename(os.path.normpath(run.run_dir))
+
+
+def _fmt(key: str, value) -> str:
+    if key == "select" and isinstance(value, bool):
+        return "select" if value else "no-select"
+    if isinstance(value, list):
+        value = ",".join(str(v) for v in value)
+    return f"{key}={value}"
+
+
+def labels(runs: Sequence[Run]) -> tuple[list[str], list[str]]:
+    """Per run: its label, and its label without the seed (the --group key).
+
+    A label is ``env``, ``select``/``no-select``, any other setting that differs between
+    the runs shown (a sweep's sigma or horizon), then ``s<seed>``; runs without a usable
+    config.json are named by their directory.
+    """
+    configs = [r.config for r in runs if "env" in r.config]
+    keys = sorted({k for c in configs for k in c} - _NOT_IDENTITY - {"env", "select"})
+    varying = [k for k in keys if len({json.dumps(c.get(k), sort_keys=True) for c in configs}) > 1]
+    full, group = [], []
+    for run in runs:
+        c = run.config
+        if "env" not in c:
+            full.append(_dir_name(run))
+            group.append(_dir_name(run))
+            continue
+        parts = [str(c["env"])]
+        if "select" in c:
+            parts.append(_fmt("select", c["select"]))
+        parts += [_fmt(k, c.get(k)) for k in varying]
+        group.append(" ".join(parts))
+        full.append(" ".join(parts + ([f"s{c['seed']}"] if "seed" in c else [])))
+    seen: dict[str, int] = {}
+    for label in full:
+        seen[label] = seen.get(label, 0) + 1
+    full = [f"{label} ({_dir_name(r)})" if seen[label] > 1 else label for label, r in zip(full, runs, strict=True)]
+    return full, group
+
+
+def smooth(y: np.ndarray, k: int) -> np.ndarray:
+    """Trailing mean over the last ``k`` evaluations (fewer at the start), so no point sees the future."""
+    if k <= 1:
+        return y
+    c = np.cumsum(np.insert(y, 0, 0.0))
+    i = np.arange(1, len(y) + 1)
+    lo = np.maximum(i - k, 0)
+    return (c[i] - c[lo]) / (i - lo)
+
+
+@dataclasses.dataclass(frozen=True)
+class Curve:
+    label: str
+    columns: dict[str, np.ndarray]  # mean over the runs it stands for
+    low: dict[str, np.ndarray] | None = None  # min over runs (only for a group of several runs)
+    high: dict[str, np.ndarray] | None = None
+
+
+def _curves(runs: Sequence[Run], k: int, group: bool) -> list[Curve]:
+    full, grouped = labels(runs)
+    smoothed = [
+        {**r.columns, **{m: smooth(r.columns[m], k) for m in ("eval_success", "eval_success_final", "eval_return")}}
+        for r in runs
+    ]
+    if not group:
+        return [Curve(label, cols) for label, cols in zip(full, smoothed, strict=True)]
+    members: dict[str, list[dict[str, np.ndarray]]] = {}
+    for key, cols in zip(grouped, smoothed, strict=True):
+        members.setdefault(key, []).append(cols)
+    curves = []
+    for key, group_cols in members.items():
+        if len(group_cols) == 1:
+            curves.append(Curve(f"{key} (1 run)", group_cols[0]))
+            continue
+        # Average evaluations all members reached, so the mean never mixes in fewer runs.
+        common = sorted(set.intersection(*(set(c["iteration"].tolist()) for c in group_cols)))
+        stacked = {
+            m: np.stack([c[m][np.searchsorted(c["iteration"], common)] for c in group_cols]) for m in group_cols[0]
+        }
+        curves.append(
+            Curve(
+                f"{key} ({len(group_cols)} runs)",
+                {m: v.mean(0) for m, v in stacked.items()},
+                {m: v.min(0) for m, v in stacked.items()},
+                {m: v.max(0) for m, v in stacked.items()},
+            )
+        )
+    return curves
+
+
+def figure(runs: Sequence[Run], k: int = 1, group: bool = False) -> Figure:
+    curves = _curves(runs, k, group)
+    fig = Figure(figsize=(15, 8), layout="constrained")
+    axes = fig.subplots(2, 3, sharey="row")
+    cmap = matplotlib.colormaps["tab10" if len(curves) <= 10 else "tab20"]
+    for i, curve in enumerate(curves):
+        color = cmap(i % cmap.N)
+        for col, (x_key, _) in enumerate(_X_AXES):
+            x = curve.columns[x_key]
+            for row, metrics in enumerate((("eval_success", "eval_success_final"), ("eval_return",))):
+                ax = axes[row, col]
+                for metric, style in zip(metrics, ("-", "--"), strict=False):
+                    label = curve.label if (row, col, style) == (0, 0, "-") else None
+                    ax.plot(x, curve.columns[metric], style, color=color, label=label, lw=1.5)
+                if curve.low is not None:
+                    m = metrics[0]
+                    ax.fill_between(x, curve.low[m], curve.high[m], color=color, alpha=0.2, lw=0)
+    for col, (x_key, x_label) in enumerate(_X_AXES):
+        axes[1, col].set_xlabel(x_label)
+        for row in range(2):
+            axes[row, col].grid(alpha=0.3)
+            if x_key != "wall_s":
+                axes[row, col].xaxis.set_major_formatter(EngFormatter(sep=""))  # 400k, not 400000
+    axes[0, 0].set_ylabel("eval success (solid: any step, dashed: final step)")
+    axes[1, 0].set_ylabel("eval return")
+    axes[0, 0].set_ylim(-0.02, 1.02)
+    axes[0, 0].legend(fontsize="small", loc="best")
+    title = "min-max band over seeds" if group else ""
+    if k > 1:
+        title = f"{title}, " if title else ""
+        title += f"trailing mean over {k} evaluations"
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 1, got {text}")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m splid_jax.plot", description=__doc__.splitlines()[0])
+    parser.add_argument("run_dirs", nargs="+", metavar="RUN_DIR", help="run directory with metrics.jsonl")
+    parser.add_argument("--out", metavar="FILE.png", help="output image (default: RUN_DIR/curves.png of the first)")
+    parser.add_argument("--smooth", type=_positive_int, default=1, metavar="K", help="trailing mean over K evals")
+    parser.add_argument("--group", action="store_true", help="average runs that differ only in seed (min-max band)")
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    try:
+        ns = build_parser().parse_args(argv)
+    except SystemExit as e:  # argparse already printed usage or help
+        return int(e.code or 0)
+    try:
+        runs = [load_run(d) for d in ns.run_dirs]
+    except PlotError as e:
+        print(f"plot: {e}", file=sys.stderr)
+        return 2
+    out = ns.out or os.path.join(ns.run_dirs[0], "curves.png")
+    try:
+        if os.path.dirname(out):
+            os.makedirs(os.path.dirname(out), exist_ok=True)
+        figure(runs, ns.smooth, ns.group).savefig(out, dpi=110)
+    except OSError as e:
+        print(f"plot: cannot write {out}: {e.strerror or e}", file=sys.stderr)
+        return 2
+    print(out)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

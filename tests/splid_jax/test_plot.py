@@ -1,0 +1,123 @@
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from splid_jax import plot
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def make_run(root: Path, name: str, seed: int, select: bool = True, n: int = 12, **config) -> Path:
+    run = root / name
+    run.mkdir(parents=True)
+    (run / "config.json").write_text(json.dumps({"env": "point", "select": select, "seed": seed, **config}))
+    rng = np.random.default_rng(seed)
+    with open(run / "metrics.jsonl", "w") as fh:
+        for i in range(1, n + 1):
+            success = min(1.0, i / n + 0.1 * rng.random())
+            rec = {
+                "iteration": 10 * i,
+                "episodes": 640 * i,
+                "env_steps": 640 * 50 * i,
+                "select_steps": (3000 * i) if select else 0,
+                "eval_success": success,
+                "eval_success_final": 0.8 * success,
+                "eval_return": -50 + 40 * success,
+                "wall_s": 2.0 * i + rng.random(),
+                "bc_loss": 0.1,
+            }
+            fh.write(json.dumps(rec) + "\n")
+    return run
+
+
+def assert_png(path: Path):
+    assert path.is_file()
+    assert path.read_bytes()[:8] == PNG_MAGIC
+    assert path.stat().st_size > 20_000  # six panels with curves, not an empty canvas
+
+
+def test_two_runs_default_output(tmp_path, capsys):
+    a = make_run(tmp_path, "point-s0", 0)
+    b = make_run(tmp_path, "point-nosel-s1", 1, select=False)
+    assert plot.main([str(a), str(b), "--smooth", "3"]) == 0
+    assert_png(a / "curves.png")
+    assert capsys.readouterr().out.strip() == str(a / "curves.png")
+
+
+def test_group_and_out(tmp_path):
+    dirs = [make_run(tmp_path, f"s{s}", s, sigma=0.5) for s in range(3)]
+    dirs += [make_run(tmp_path, f"h{s}", s, sigma=1.0, n=10) for s in range(2)]
+    out = tmp_path / "figs" / "sweep.png"
+    assert plot.main([*map(str, dirs), "--group", "--out", str(out)]) == 0
+    assert_png(out)
+
+
+def test_labels_and_groups(tmp_path):
+    runs = [
+        plot.load_run(make_run(tmp_path, "a", 0, sigma=0.5, horizon=8)),
+        plot.load_run(make_run(tmp_path, "b", 1, sigma=0.5, horizon=8)),
+        plot.load_run(make_run(tmp_path, "c", 0, select=False, sigma=1.0, horizon=8)),
+    ]
+    (tmp_path / "bare").mkdir()
+    (tmp_path / "bare" / "metrics.jsonl").write_text((tmp_path / "a" / "metrics.jsonl").read_text())
+    runs.append(plot.load_run(tmp_path / "bare"))
+    full, group = plot.labels(runs)
+    assert full == ["point select sigma=0.5 s0", "point select sigma=0.5 s1", "point no-select sigma=1.0 s0", "bare"]
+    assert group[0] == group[1] != group[2]
+
+
+def test_group_mean_and_band(tmp_path):
+    dirs = [make_run(tmp_path, f"s{s}", s, n=8 + s) for s in range(3)]  # unequal lengths: common evals only
+    runs = [plot.load_run(d) for d in dirs]
+    (curve,) = plot._curves(runs, k=1, group=True)
+    ys = np.stack([r.columns["eval_success"][:8] for r in runs])
+    assert len(curve.columns["eval_success"]) == 8
+    np.testing.assert_allclose(curve.columns["eval_success"], ys.mean(0))
+    np.testing.assert_allclose(curve.low["eval_success"], ys.min(0))
+    np.testing.assert_allclose(curve.high["eval_success"], ys.max(0))
+
+
+def test_smooth_is_trailing_mean():
+    np.testing.assert_allclose(plot.smooth(np.array([0.0, 3.0, 6.0, 9.0]), 2), [0.0, 1.5, 4.5, 7.5])
+    np.testing.assert_allclose(plot.smooth(np.array([1.0, 2.0]), 1), [1.0, 2.0])
+
+
+def test_truncated_last_line_is_ignored(tmp_path):
+    run = make_run(tmp_path, "r", 0, n=5)
+    with open(run / "metrics.jsonl", "a") as fh:
+        fh.write('{"iteration": 60, "episo')
+    assert len(plot.load_run(run).columns["iteration"]) == 5
+
+
+@pytest.mark.parametrize(
+    "setup, message",
+    [
+        (lambda root: root / "nope", "no such run directory"),
+        (lambda root: root.joinpath("empty_dir").mkdir() or root / "empty_dir", "no metrics file"),
+        (lambda root: _with_metrics(root, ""), "no evaluation records"),
+        (lambda root: _with_metrics(root, '{"iteration": 1}\n'), "record 1 lacks episodes"),
+        (lambda root: _with_metrics(root, "garbage\n{}\n"), "metrics.jsonl:1: not a JSON object"),
+    ],
+    ids=["missing-dir", "missing-metrics", "empty-metrics", "missing-key", "bad-line"],
+)
+def test_errors_exit_2(tmp_path, capsys, setup, message):
+    good = make_run(tmp_path, "good", 0)
+    bad = setup(tmp_path)
+    assert plot.main([str(good), str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+    assert not (good / "curves.png").exists()
+
+
+def _with_metrics(root: Path, text: str) -> Path:
+    run = root / "bad"
+    run.mkdir()
+    (run / "metrics.jsonl").write_text(text)
+    return run
+
+
+def test_bad_arguments_exit_2(tmp_path):
+    assert plot.main([str(make_run(tmp_path, "r", 0)), "--smooth", "0"]) == 2
+    assert plot.main([]) == 2
