@@ -31,7 +31,7 @@ class CheckpointError(RuntimeError):
 
 
 def checkpoint_dir(run_dir: str | Path) -> Path:
-    return Path(run_dir) / "checkpoints"
+    return Path(run_dir).absolute() / "checkpoints"  # orbax needs absolute paths
 
 
 def _manager(directory: Path, *, read_only: bool, max_to_keep: int = MAX_TO_KEEP) -> ocp.CheckpointManager:

@@ -78,7 +78,7 @@ class TrainConfig:
 
 
 _POINT = dict(
-    iterations=60,
+    iterations=100,
     num_envs=32,
     buffer_size=200_000,
     batch_size=256,

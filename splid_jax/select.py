@@ -2,8 +2,11 @@
 
 For every explored step t and every h in 1..H the candidate is (s_t, g' = m(s_{t+h}), a_t). SELECT
 restores s_t pursuing g' and runs the current deterministic policy for h steps: if the policy
-reaches g', the explored actions were no faster and the pair is rejected. All candidates of one
-h are one vmapped replay of exactly h steps, so no step is simulated past its own horizon."""
+reaches g', the explored actions were no faster and the pair is rejected.
+
+Layout: candidates are [H, T, N] (h-major), flattened. A ``lax.scan`` over h replays all T x N
+candidates of one h in one vmapped loop of exactly h steps, so the simulator step appears once in
+the compiled program (MJX compile time) and no step is simulated past its own horizon."""
 
 from __future__ import annotations
 
@@ -20,33 +23,33 @@ from splid_jax.networks import Policy, PolicyState
 class Candidates(NamedTuple):
     """Flat batch of relabelled pairs; the layout is static, validity lives in masks."""
 
-    obs: jax.Array  # [M, O]
+    obs: jax.Array  # [M, O], M = H * T * N
     goal: jax.Array  # [M, G]
     action: jax.Array  # [M, A]
-    valid: jax.Array  # [M] a real candidate: the achieved goal moved, no NaN, h <= horizon
+    valid: jax.Array  # [M] a real candidate: t + h <= T, the goal moved, no NaN, h <= horizon
     accept: jax.Array  # [M] valid and not solved by the current policy within h steps
 
 
-def policy_reaches(env: GoalEnv, policy: Policy, pstate: PolicyState, state: State, goal: jax.Array, h: int):
-    """Whether the deterministic policy, restored at ``state``, hits ``goal`` within ``h`` steps."""
+def policy_reaches(env: GoalEnv, policy: Policy, pstate: PolicyState, state: State, goal: jax.Array, h):
+    """Whether the deterministic policy, restored at ``state``, hits ``goal`` within ``h`` steps
+    (``h`` may be traced: the loop runs exactly h steps)."""
 
-    def one_step(carry, _):
+    def one_step(_, carry):
         s, hit = carry
         s = env.step(s, policy.act(pstate, s.obs, s.desired_goal))
-        return (s, hit | (s.success & ~s.invalid)), None
+        return s, hit | (s.success & ~s.invalid)
 
-    start = env.with_goal(state, goal)
-    (_, hit), _ = jax.lax.scan(one_step, (start, jnp.bool_(False)), None, length=h)
+    _, hit = jax.lax.fori_loop(0, h, one_step, (env.with_goal(state, goal), jnp.bool_(False)))
     return hit
 
 
 def num_candidates(episode_length: int, max_horizon: int, num_envs: int) -> int:
-    return num_envs * sum(episode_length - h + 1 for h in range(1, max_horizon + 1))
+    return max_horizon * episode_length * num_envs
 
 
 def replay_steps(episode_length: int, horizon: int, num_envs: int) -> int:
-    """Simulator steps SELECT takes per iteration (for reporting)."""
-    return num_envs * sum(h * (episode_length - h + 1) for h in range(1, horizon + 1))
+    """Simulator steps SELECT takes per iteration: h steps for each of the T x N starts, per h."""
+    return num_envs * episode_length * horizon * (horizon + 1) // 2
 
 
 def select(
@@ -58,27 +61,34 @@ def select(
     horizon: jax.Array,
     use_select: bool,
 ) -> Candidates:
-    """``max_horizon`` fixes the shapes; ``horizon`` (traced, <= max_horizon) masks, so runs with
-    different H can share one compiled program. ``use_select=False`` stores every valid pair."""
-    T = env.episode_length
-    parts = []
-    for h in range(1, max_horizon + 1):
-        n_t = T - h + 1  # t = 0..T-h so that t + h <= T
-        states = jax.tree_util.tree_map(lambda x, n=n_t: x[:n], traj.states)
-        goal = traj.achieved[h : T + 1]
-        valid = (
-            ~env.success(traj.achieved[:n_t], goal)  # nothing achieved between t and t + h
-            & ~traj.invalid[:n_t]
-            & ~traj.invalid[h : T + 1]
-            & (h <= horizon)
-        )
-        flat = jax.tree_util.tree_map(lambda x: x.reshape((-1,) + x.shape[2:]), (states, goal, traj.actions[:n_t]))
-        states_f, goal_f, action_f = flat
-        valid = valid.reshape(-1)
-        if use_select:
-            reached = jax.vmap(lambda s, g, h=h: policy_reaches(env, policy, pstate, s, g, h))(states_f, goal_f)
-            accept = valid & ~reached
-        else:
-            accept = valid
-        parts.append(Candidates(states_f.obs, goal_f, action_f, valid, accept))
-    return Candidates(*(jnp.concatenate(xs, axis=0) for xs in zip(*parts, strict=True)))
+    """``max_horizon`` fixes the shapes; ``horizon`` (traced, <= max_horizon) masks and skips
+    the replays of larger h, so runs with different H share one compiled program.
+    ``use_select=False`` is the ablation: every valid pair is stored, nothing is replayed."""
+    T, H = env.episode_length, max_horizon
+    n = traj.actions.shape[1]
+    hs = jnp.arange(1, H + 1)
+    t = jnp.arange(T)
+    later = jnp.minimum(t[None, :] + hs[:, None], T)  # [H, T] index of s_{t+h}, clamped
+    goal = traj.achieved[later]  # [H, T, N, G]
+    valid = (
+        (t[None, :] + hs[:, None] <= T)[..., None]
+        & ~env.success(traj.achieved[:T][None], goal)  # nothing achieved between t and t + h
+        & ~traj.invalid[:T][None]
+        & ~traj.invalid[later]
+        & (hs <= horizon)[:, None, None]
+    ).reshape(-1)
+    goal = goal.reshape(H, T * n, -1)
+    if use_select:
+        starts = jax.tree_util.tree_map(lambda x: x.reshape((T * n,) + x.shape[2:]), traj.states)
+        replay = jax.vmap(lambda s, g, h: policy_reaches(env, policy, pstate, s, g, h), in_axes=(0, 0, None))
+
+        def per_h(_, xs):
+            h, goal_h = xs
+            return None, replay(starts, goal_h, jnp.where(h <= horizon, h, 0))
+
+        _, reached = jax.lax.scan(per_h, None, (hs, goal))
+        accept = valid & ~reached.reshape(-1)
+    else:
+        accept = valid
+    tile = lambda x: jnp.broadcast_to(x[None], (H,) + x.shape).reshape((H * T * n,) + x.shape[2:])  # noqa: E731
+    return Candidates(tile(traj.states.obs), goal.reshape(H * T * n, -1), tile(traj.actions), valid, accept)

@@ -1,0 +1,135 @@
+"""Speed of the SPLID iteration on one device: SELECT verdicts per second, chunk time, compile
+time, and the cost of vmapping seeds, each against a peer measured in the same run.
+
+    python experiments/bench_splid.py --env push --num-envs 64,256,1024 --seeds 8 --out bench.json
+
+Peers: SELECT on this machine's CPU cores through the same JAX code (``--cpu-peer``), and one seed
+for the vmapped-seeds ratio. Medians over ``--repeats`` timed calls after one warm-up call; compile
+time is the first call's time minus the median."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import statistics
+import time
+
+import jax
+import jax.numpy as jnp
+
+from splid_jax.config import TrainConfig
+from splid_jax.explore import explore
+from splid_jax.select import select
+from splid_jax.train import make_env
+from splid_jax.trainer import Trainer
+
+
+def timed(fn, *args, repeats: int):
+    t0 = time.perf_counter()
+    jax.block_until_ready(fn(*args))
+    first = time.perf_counter() - t0
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        jax.block_until_ready(fn(*args))
+        times.append(time.perf_counter() - t0)
+    med = statistics.median(times)
+    return {"median_s": med, "compile_s": max(first - med, 0.0), "runs": len(times)}
+
+
+def bench_select(env, cfg: TrainConfig, device, repeats: int) -> dict:
+    """Time SELECT alone on one explored batch; verdicts = candidates with t + h <= T."""
+    trainer = Trainer(env, cfg)
+    with jax.default_device(device):
+        state = trainer.init(jax.random.PRNGKey(0))
+        traj = jax.jit(lambda ps, k: explore(env, trainer.policy, ps, k, cfg.num_envs, jnp.float32(cfg.sigma)))(
+            state.policy, jax.random.PRNGKey(1)
+        )
+        fn = jax.jit(lambda ps, tr: select(env, trainer.policy, ps, tr, cfg.horizon, jnp.int32(cfg.horizon), True))
+        out = timed(fn, state.policy, traj, repeats=repeats)
+        cands = fn(state.policy, traj)
+    T, H, N = env.episode_length, cfg.horizon, cfg.num_envs
+    verdicts = N * sum(T - h + 1 for h in range(1, H + 1))
+    out.update(
+        device=str(device),
+        num_envs=N,
+        verdicts=verdicts,
+        valid=int(cands.valid.sum()),
+        verdicts_per_s=verdicts / out["median_s"],
+        replay_steps_per_s=trainer.counters(1)["select_steps"] / out["median_s"],
+    )
+    return out
+
+
+def bench_chunk(env, cfg: TrainConfig, seeds: int, repeats: int) -> dict:
+    """Time whole compiled chunks (explore, SELECT, insert, BC, eval) for 1 seed and ``seeds`` seeds."""
+    trainer = Trainer(env, cfg)
+    one = timed(trainer.chunk, trainer.init(jax.random.PRNGKey(0)), trainer.hyper(), repeats=repeats)
+    keys = jnp.stack([jax.random.PRNGKey(s) for s in range(seeds)])
+    states = jax.vmap(trainer.init)(keys)
+    hyper = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (seeds,)), trainer.hyper())
+    many = timed(jax.jit(jax.vmap(trainer._chunk)), states, hyper, repeats=repeats)
+    return {
+        "num_envs": cfg.num_envs,
+        "iterations_per_chunk": cfg.eval_every,
+        "one_seed": one,
+        f"{seeds}_seeds": many,
+        "seeds": seeds,
+        "ratio_many_over_one": many["median_s"] / one["median_s"],
+    }
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--env", default="push")
+    p.add_argument("--num-envs", default="64,256,1024")
+    p.add_argument("--horizon", type=int, default=8)
+    p.add_argument("--seeds", type=int, default=8)
+    p.add_argument("--eval-every", type=int, default=5)
+    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--cpu-peer", type=int, default=0, help="num_envs for the SELECT peer on the CPU (0: skip)")
+    p.add_argument("--skip-chunk", action="store_true")
+    p.add_argument("--out", default=None)
+    a = p.parse_args()
+    env = make_env(a.env)
+    base = TrainConfig(env=a.env, horizon=a.horizon, eval_every=a.eval_every, iterations=a.eval_every, run_dir="/tmp/x")
+    dev = jax.devices()[0]
+    res = {
+        "env": a.env,
+        "device": dev.device_kind,
+        "platform": dev.platform,
+        "jax": jax.__version__,
+        "date": time.strftime("%Y-%m-%d"),
+        "select": [],
+        "chunk": [],
+    }
+    for n in [int(x) for x in a.num_envs.split(",")]:
+        cfg = dataclasses.replace(base, num_envs=n)
+        r = bench_select(env, cfg, dev, a.repeats)
+        res["select"].append(r)
+        print(
+            f"SELECT {dev.platform} N={n}: {r['verdicts_per_s']:,.0f} verdicts/s, "
+            f"{r['replay_steps_per_s']:,.0f} replay steps/s, {r['median_s']:.3f}s, compile {r['compile_s']:.1f}s",
+            flush=True,
+        )
+        if not a.skip_chunk:
+            c = bench_chunk(env, cfg, a.seeds, a.repeats)
+            res["chunk"].append(c)
+            print(
+                f"CHUNK N={n}: 1 seed {c['one_seed']['median_s']:.3f}s (compile {c['one_seed']['compile_s']:.1f}s), "
+                f"{a.seeds} seeds {c[f'{a.seeds}_seeds']['median_s']:.3f}s: ratio {c['ratio_many_over_one']:.2f}",
+                flush=True,
+            )
+    if a.cpu_peer:
+        cpu = jax.devices("cpu")[0]
+        r = bench_select(env, dataclasses.replace(base, num_envs=a.cpu_peer), cpu, max(1, a.repeats // 2))
+        res["select_cpu_peer"] = r
+        print(f"SELECT cpu peer N={a.cpu_peer}: {r['verdicts_per_s']:,.0f} verdicts/s", flush=True)
+    if a.out:
+        with open(a.out, "w") as fh:
+            json.dump(res, fh, indent=2)
+
+
+if __name__ == "__main__":
+    main()
