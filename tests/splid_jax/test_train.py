@@ -1,0 +1,152 @@
+"""The command line and its run directory: bad input, resume after a real kill, Ctrl-C, NaN,
+corrupt and mismatched checkpoints. All on the point task, in subprocesses where a signal is real."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import jax
+import numpy as np
+import pytest
+
+from splid_jax import checkpoint
+from splid_jax.config import TrainConfig
+from splid_jax.train import RunStopped, main, run
+from splid_jax.trainer import Trainer
+
+TINY = ["--env", "point", "--num-envs", "8", "--eval-episodes", "16", "--bc-steps", "40", "--batch-size", "64",
+        "--hidden", "32,32", "--eval-every", "5"]  # fmt: skip
+VOLATILE = {"wall_s", "steps_per_s"}
+
+
+def cli(*args, **kw):
+    return subprocess.Popen(
+        [sys.executable, "-m", "splid_jax.train", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        **kw,
+    )
+
+
+def stable(path):
+    with open(os.path.join(path, "metrics.jsonl")) as fh:
+        return [{k: v for k, v in json.loads(line).items() if k not in VOLATILE} for line in fh]
+
+
+def final_params(run_dir):
+    cfg = TrainConfig(**{**json.load(open(os.path.join(run_dir, "config.json"))), "hidden": (32, 32)})
+    trainer = Trainer(__import__("envs").make("point"), cfg)
+    _, state, _ = checkpoint.restore(run_dir, trainer.init(jax.random.PRNGKey(0)))
+    return jax.tree_util.tree_leaves(state)
+
+
+@pytest.mark.parametrize(
+    "args,field",
+    [
+        (["--sigma", "-1"], "sigma"),
+        (["--horizon", "0"], "horizon"),
+        (["--horizon", "50"], "horizon"),
+        (["--num-envs", "0"], "num_envs"),
+        (["--env", "nope"], "env"),
+        (["--iterations", "7", "--eval-every", "5"], "iterations"),
+    ],
+)
+def test_bad_values_stop_before_any_work(tmp_path, capsys, args, field):
+    run_dir = tmp_path / "run"
+    assert main(["--run-dir", str(run_dir), *args]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and field in err
+    assert not run_dir.exists()
+
+
+def test_run_dir_that_is_a_file_is_refused(tmp_path, capsys):
+    f = tmp_path / "file"
+    f.write_text("x")
+    assert main(["--run-dir", str(f)]) == 2
+    assert "run_dir" in capsys.readouterr().err
+
+
+def test_help_documents_every_flag(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--help"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    for flag in ["--env", "--seed", "--iterations", "--num-envs", "--sigma", "--horizon", "--no-select", "--run-dir",
+                 "--resume"]:  # fmt: skip
+        assert flag in out
+
+
+@pytest.mark.slow
+def test_resume_after_kill_matches_an_uninterrupted_run(tmp_path):
+    whole, killed = str(tmp_path / "whole"), str(tmp_path / "killed")
+    args = [*TINY, "--iterations", "60", "--quiet"]
+    reference = cli(*args, "--run-dir", whole)
+    victim = cli(*args, "--run-dir", killed)
+    deadline = time.time() + 240
+    while (checkpoint.latest_step(killed) or 0) < 10 and victim.poll() is None and time.time() < deadline:
+        time.sleep(0.02)
+    victim.send_signal(signal.SIGKILL)
+    victim.wait()
+    assert victim.returncode == -signal.SIGKILL, "the run ended before it could be killed"
+    killed_at = checkpoint.latest_step(killed)
+    assert 10 <= killed_at < 60
+    assert reference.wait() == 0, reference.stderr.read()
+    resumed = cli("--resume", killed, "--quiet")
+    assert resumed.wait() == 0, resumed.stderr.read()
+    assert checkpoint.latest_step(killed) == 60
+    assert stable(killed) == stable(whole)
+    for a, b in zip(final_params(killed), final_params(whole), strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.slow
+def test_ctrl_c_saves_and_exits_cleanly(tmp_path):
+    run_dir = str(tmp_path / "run")
+    proc = cli(*TINY, "--iterations", "1000", "--run-dir", run_dir)
+    deadline = time.time() + 240
+    while (checkpoint.latest_step(run_dir) or 0) < 5 and proc.poll() is None and time.time() < deadline:
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGINT)
+    out, _ = proc.communicate(timeout=120)
+    assert proc.returncode == 130
+    step = checkpoint.latest_step(run_dir)
+    assert "interrupted: saved iteration" in out and f"iteration {step} " in out
+    assert stable(run_dir)[-1]["iteration"] == step
+
+
+@pytest.mark.slow
+def test_nan_stops_the_run_and_keeps_the_last_good_checkpoint(tmp_path):
+    cfg = TrainConfig(env="point", num_envs=8, eval_episodes=16, bc_steps=5, batch_size=32, hidden=(16,),
+                      eval_every=5, iterations=20, learning_rate=1e38, run_dir=str(tmp_path / "run"))  # fmt: skip
+    with pytest.raises(RunStopped, match="non-finite"):
+        run(cfg, quiet=True)
+    step = checkpoint.latest_step(cfg.run_dir)
+    assert step is not None and step < 20
+    trainer = Trainer(__import__("envs").make("point"), cfg)
+    _, state, _ = checkpoint.restore(cfg.run_dir, trainer.init(jax.random.PRNGKey(0)))
+    assert all(np.isfinite(np.asarray(x)).all() for x in jax.tree_util.tree_leaves(state.policy.params))
+
+
+@pytest.mark.slow
+def test_corrupt_and_mismatched_checkpoints_fail_clearly(tmp_path, capsys):
+    run_dir = tmp_path / "run"
+    assert main([*TINY, "--iterations", "5", "--run-dir", str(run_dir), "--quiet"]) == 0
+    assert main(["--resume", str(run_dir), "--hidden", "8"]) == 2  # a changed network is not this run
+    assert "hidden" in capsys.readouterr().err
+    cfg = json.loads((run_dir / "config.json").read_text())
+    (run_dir / "config.json").write_text(json.dumps({**cfg, "hidden": [8]}))
+    assert main(["--resume", str(run_dir), "--iterations", "10", "--quiet"]) == 3
+    assert "hidden" in capsys.readouterr().err
+    (run_dir / "config.json").write_text(json.dumps(cfg))
+    for root, _, files in os.walk(run_dir / "checkpoints"):
+        for name in files:
+            path = os.path.join(root, name)
+            if os.path.getsize(path) > 64:
+                with open(path, "r+b") as fh:
+                    fh.truncate(os.path.getsize(path) // 2)
+    assert main(["--resume", str(run_dir), "--iterations", "10", "--quiet"]) == 3
+    assert "error" in capsys.readouterr().err
