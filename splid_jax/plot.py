@@ -1,9 +1,8 @@
 """``python -m splid_jax.plot RUN_DIR [RUN_DIR...]``: learning curves of one or more runs.
 
 Rows: evaluation success (solid: at any step, dashed: at the final step) and evaluation
-return. Columns: episodes, simulator steps and wall-clock seconds. The step axis counts
-SELECT's replay steps as well as exploration steps, so select and no-select runs are
-compared at equal simulation cost.
+return. Columns: episodes, exploration env steps (``--steps all`` adds SELECT's replay steps, to
+compare select and no-select runs at equal simulation cost) and wall-clock seconds.
 """
 
 from __future__ import annotations
@@ -32,11 +31,14 @@ REQUIRED = (
 )
 # Config keys that never change what a run learns, so they neither label nor split runs.
 _NOT_IDENTITY = {"run_dir", "seed", "checkpoint_every"}
-_X_AXES = (
-    ("episodes", "episodes"),
-    ("sim_steps", "simulator steps (env + SELECT replay)"),
-    ("wall_s", "wall clock (s)"),
-)
+_STEP_AXES = {
+    "env": ("env_steps", "exploration env steps"),
+    "all": ("sim_steps", "simulator steps (env + SELECT replay)"),
+}
+
+
+def _x_axes(steps: str = "env") -> tuple[tuple[str, str], ...]:
+    return (("episodes", "episodes"), _STEP_AXES[steps], ("wall_s", "wall clock (s)"))
 
 
 class PlotError(ValueError):
@@ -183,14 +185,14 @@ def _curves(runs: Sequence[Run], k: int, group: bool) -> list[Curve]:
     return curves
 
 
-def figure(runs: Sequence[Run], k: int = 1, group: bool = False) -> Figure:
+def figure(runs: Sequence[Run], k: int = 1, group: bool = False, steps: str = "env") -> Figure:
     curves = _curves(runs, k, group)
     fig = Figure(figsize=(15, 8), layout="constrained")
     axes = fig.subplots(2, 3, sharey="row")
     cmap = matplotlib.colormaps["tab10" if len(curves) <= 10 else "tab20"]
     for i, curve in enumerate(curves):
         color = cmap(i % cmap.N)
-        for col, (x_key, _) in enumerate(_X_AXES):
+        for col, (x_key, _) in enumerate(_x_axes(steps)):
             x = curve.columns[x_key]
             for row, metrics in enumerate((("eval_success", "eval_success_final"), ("eval_return",))):
                 ax = axes[row, col]
@@ -200,7 +202,7 @@ def figure(runs: Sequence[Run], k: int = 1, group: bool = False) -> Figure:
                 if curve.low is not None:
                     m = metrics[0]
                     ax.fill_between(x, curve.low[m], curve.high[m], color=color, alpha=0.2, lw=0)
-    for col, (x_key, x_label) in enumerate(_X_AXES):
+    for col, (x_key, x_label) in enumerate(_x_axes(steps)):
         axes[1, col].set_xlabel(x_label)
         for row in range(2):
             axes[row, col].grid(alpha=0.3)
@@ -232,6 +234,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--out", metavar="FILE.png", help="output image (default: RUN_DIR/curves.png of the first)")
     parser.add_argument("--smooth", type=_positive_int, default=1, metavar="K", help="trailing mean over K evals")
     parser.add_argument("--group", action="store_true", help="average runs that differ only in seed (min-max band)")
+    parser.add_argument(
+        "--steps", choices=sorted(_STEP_AXES), default="env", help="env: exploration steps; all: + SELECT"
+    )
     return parser
 
 
@@ -249,7 +254,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if os.path.dirname(out):
             os.makedirs(os.path.dirname(out), exist_ok=True)
-        figure(runs, ns.smooth, ns.group).savefig(out, dpi=110)
+        figure(runs, ns.smooth, ns.group, ns.steps).savefig(out, dpi=110)
     except OSError as e:
         print(f"plot: cannot write {out}: {e.strerror or e}", file=sys.stderr)
         return 2
