@@ -1,0 +1,1 @@
+"""Fetch-style manipulation tasks (Reach, Push, Slide, PickAndPlace) as pure MJX functions."""

@@ -1,0 +1,215 @@
+"""MJCF models of the Fetch-style tasks, written for MJX: a gripper, a table and an object.
+
+Everything is a primitive geom with ``contype = conaffinity = 0``; the only collisions are the
+``<contact><pair>`` entries listed below, so MJX evaluates exactly those and nothing else.
+
+The gripper is a body on three world-aligned slide joints (x, y, z), each driven by a position
+actuator (kp = m w^2, w = 50 rad/s) with joint damping 2 m w (critical), so it follows its target
+like the reference's mocap weld (solref 0.02 1) follows the mocap body. The joint damping is
+integrated implicitly by the Euler integrator, so the drive stays stable at 10 ms timesteps; the z
+actuator carries a constant bias ``m g`` (gravity compensation, as the reference arm is held by its
+weld). Fingers: for Reach/Push/Slide (gripper blocked) they are one fixed closed block; for
+PickAndPlace two slide joints with position actuators (kp 30000, control 0..0.2, joint range
+0..0.05, as the reference) and friction-1, condim-4 contacts with the object.
+
+Why slide joints, not the reference's mocap weld: measured on this 2-core CPU (shared, so
+figures are rough) on the Push model at 10 x 4 ms, the slide-joint drive ran 7,200 control
+steps/s in MuJoCo C and 1,050 in MJX at batch 64 (compile 24 s), a free-joint gripper welded to a
+mocap body 5,100 and 590 (compile 50 s): the weld adds 3 dofs and 6 constraint rows. Both follow a
+target moved 5 cm ahead at every control step alike: the grip advances 3.0 cm in the first step,
+then 3.4 cm per step (weld: 3.2 cm), and stops within 0.2 mm of the target once it is held, so
+neither reaches the full 5 cm within one step, the reference's weld (same time constant) neither.
+
+Contact pairs: object-table (box-box), object-floor (plane-box), finger(s)-object (box-box). The
+gripper has no pair with the table: its z target is clipped so that the fingertips stay at or above
+the table top instead (see ``Layout.workspace``).
+
+Slide: MJX cannot collide a cylinder with a box, so the puck is a box of half-size
+0.025 x 0.025 x 0.02 (the reference cylinder's radius and half-height), mass 2, with the
+reference's low friction (0.1, 0.005, 0.0001) on the puck-table pair.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+
+import mujoco
+import numpy as np
+
+TABLE_TOP = 0.4
+OBJECT_HALF = 0.025
+PUCK_HALF_HEIGHT = 0.02
+FINGER_BELOW_SITE = 0.008  # the fingertips reach this far below the grip site
+GRIPPER_MASS = 4.0  # palm + fingers, the mass the xyz drive moves
+DRIVE_OMEGA = 50.0  # rad/s: the reference weld's time constant 0.02 s
+FINGER_KP = 30000.0
+FINGER_MASS = 1.0
+
+# kind -> (table centre xyz, table half-size xyz, initial grip-site position)
+_SCENES = {
+    "reach": ((1.3, 0.75, 0.2), (0.25, 0.35, 0.2), (1.342, 0.749, 0.555)),
+    "push": ((1.3, 0.75, 0.2), (0.25, 0.35, 0.2), (1.342, 0.749, 0.555)),
+    "pick_and_place": ((1.3, 0.75, 0.2), (0.25, 0.35, 0.2), (1.342, 0.749, 0.555)),
+    "slide": ((1.32, 0.75, 0.2), (0.625, 0.45, 0.2), (1.0, 0.75, 0.41)),
+}
+KINDS = tuple(_SCENES)
+
+
+@dataclasses.dataclass(frozen=True)
+class Layout:
+    """Where things live in ``qpos``/``qvel``/``ctrl``, as Python ints (static under jit)."""
+
+    grip_q: int  # qpos/qvel address of the gripper's x slide (y, z follow)
+    finger_q: int | None  # qpos address of the left finger (right follows); None when fixed
+    finger_v: int | None
+    object_q: int | None  # qpos address of the object's free joint; None for Reach
+    object_v: int | None
+    grip_home: tuple[float, float, float]  # grip-site position when the gripper joints are 0
+    workspace_lo: tuple[float, float, float]  # clip box of the grip-site target
+    workspace_hi: tuple[float, float, float]
+    object_rest_z: float | None  # object centre height at rest on the table
+    nq: int
+    nv: int
+    nu: int
+
+
+def _fmt(*xs: float) -> str:
+    return " ".join(f"{x:.6g}" for x in xs)
+
+
+def mjcf(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations: int = 4) -> str:
+    """The MJCF text of task ``kind`` (one of ``KINDS``)."""
+    if kind not in _SCENES:
+        raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
+    (tx, ty, tz), (hx, hy, hz), (gx, gy, gz) = _SCENES[kind]
+    w = DRIVE_OMEGA
+    kp, kv = GRIPPER_MASS * w * w, 2.0 * GRIPPER_MASS * w
+    has_object = kind != "reach"
+    free_fingers = kind == "pick_and_place"
+    slide = kind == "slide"
+    obj_half = (OBJECT_HALF, OBJECT_HALF, PUCK_HALF_HEIGHT if slide else OBJECT_HALF)
+    rest_z = TABLE_TOP + obj_half[2]
+    ox, oy = gx + 0.1, gy + 0.1  # any spot on the table; reset moves it
+    finger_z = 0.03 - FINGER_BELOW_SITE  # finger box half-height 0.03, bottom at -FINGER_BELOW_SITE
+    palm_mass = GRIPPER_MASS - (2 * FINGER_MASS if free_fingers else 0.0)
+    friction = "0.1 0.1 0.005 0.0001 0.0001" if slide else "1 1 0.005 0.0001 0.0001"
+    nograv = 'contype="0" conaffinity="0"'
+
+    if free_fingers:
+        fdamp = 2.0 * FINGER_MASS * np.sqrt(FINGER_KP / FINGER_MASS)
+        fingers = f"""
+      <body name="finger_l">
+        <joint name="finger_l" type="slide" axis="0 1 0" range="0 0.05" damping="{fdamp:.6g}"/>
+        <geom name="finger_l" type="box" size="0.01 0.006 0.03" pos="0 0.006 {finger_z:.6g}"
+              mass="{FINGER_MASS}" {nograv} rgba="0.3 0.3 0.3 1"/>
+      </body>
+      <body name="finger_r">
+        <joint name="finger_r" type="slide" axis="0 -1 0" range="0 0.05" damping="{fdamp:.6g}"/>
+        <geom name="finger_r" type="box" size="0.01 0.006 0.03" pos="0 -0.006 {finger_z:.6g}"
+              mass="{FINGER_MASS}" {nograv} rgba="0.3 0.3 0.3 1"/>
+      </body>"""
+        finger_act = f"""
+    <position name="finger_l" joint="finger_l" kp="{FINGER_KP:.6g}" ctrlrange="0 0.2"/>
+    <position name="finger_r" joint="finger_r" kp="{FINGER_KP:.6g}" ctrlrange="0 0.2"/>"""
+        finger_pairs = """
+    <pair geom1="finger_l" geom2="object" condim="4" friction="1 1 0.005 0.0001 0.0001"/>
+    <pair geom1="finger_r" geom2="object" condim="4" friction="1 1 0.005 0.0001 0.0001"/>"""
+    else:
+        fingers = f"""
+      <geom name="fingers" type="box" size="0.01 0.012 0.03" pos="0 0 {finger_z:.6g}" mass="0.001"
+            {nograv} rgba="0.3 0.3 0.3 1"/>"""
+        finger_act = ""
+        finger_pairs = (
+            f"""
+    <pair geom1="fingers" geom2="object" condim="3" friction="{friction}"/>"""
+            if has_object
+            else ""
+        )
+
+    obj = ""
+    obj_pairs = ""
+    if has_object:
+        obj = f"""
+    <body name="object" pos="{_fmt(ox, oy, rest_z)}">
+      <freejoint name="object"/>
+      <geom name="object" type="box" size="{_fmt(*obj_half)}" mass="2" {nograv} rgba="0.9 0.2 0.2 1"/>
+      <site name="object" pos="0 0 0" size="0.005"/>
+    </body>"""
+        obj_pairs = f"""
+    <pair geom1="object" geom2="table" condim="3" friction="{friction}"/>
+    <pair geom1="object" geom2="floor" condim="3"/>"""
+
+    return f"""<mujoco model="fetch_{kind}">
+  <compiler angle="radian" autolimits="true"/>
+  <option timestep="{timestep:.6g}" integrator="Euler" solver="Newton" iterations="{iterations}"
+          ls_iterations="{ls_iterations}" cone="pyramidal"/>
+  <worldbody>
+    <geom name="floor" type="plane" size="3 3 0.1" {nograv} rgba="0.8 0.8 0.8 1"/>
+    <geom name="table" type="box" pos="{_fmt(tx, ty, tz)}" size="{_fmt(hx, hy, hz)}" {nograv}
+          rgba="0.6 0.5 0.4 1"/>
+    <body name="gripper" pos="{_fmt(gx, gy, gz)}">
+      <joint name="grip_x" type="slide" axis="1 0 0" damping="{kv:.6g}"/>
+      <joint name="grip_y" type="slide" axis="0 1 0" damping="{kv:.6g}"/>
+      <joint name="grip_z" type="slide" axis="0 0 1" damping="{kv:.6g}"/>
+      <site name="grip" pos="0 0 0" size="0.005"/>
+      <geom name="palm" type="box" size="0.02 0.04 0.01" pos="0 0 0.062" mass="{palm_mass:.6g}" {nograv}
+            rgba="0.3 0.3 0.3 1"/>{fingers}
+    </body>{obj}
+  </worldbody>
+  <contact>{obj_pairs}{finger_pairs}
+  </contact>
+  <actuator>
+    <general name="grip_x" joint="grip_x" gainprm="{kp:.6g}" biastype="affine" biasprm="0 {-kp:.6g} 0"/>
+    <general name="grip_y" joint="grip_y" gainprm="{kp:.6g}" biastype="affine" biasprm="0 {-kp:.6g} 0"/>
+    <general name="grip_z" joint="grip_z" gainprm="{kp:.6g}" biastype="affine"
+             biasprm="{GRIPPER_MASS * 9.81:.6g} {-kp:.6g} 0"/>{finger_act}
+  </actuator>
+</mujoco>
+"""
+
+
+def _rest_height(m: mujoco.MjModel, object_q: int) -> float:
+    """Height at which the object comes to rest on the table (contacts are soft: it sinks a little)."""
+    d = mujoco.MjData(m)
+    for _ in range(int(round(1.0 / m.opt.timestep))):
+        mujoco.mj_step(m, d)
+    return float(d.qpos[object_q + 2])
+
+
+@functools.cache
+def build(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations: int = 4):
+    """``(mj_model, mjx_model, layout)`` for task ``kind``; cached, so tasks stay hashable."""
+    import jax
+    from mujoco import mjx
+
+    m = mujoco.MjModel.from_xml_string(mjcf(kind, timestep, iterations, ls_iterations))
+    jnt = lambda name: m.joint(name)  # noqa: E731
+    grip_q = int(jnt("grip_x").qposadr[0])
+    free_fingers = kind == "pick_and_place"
+    finger_q = int(jnt("finger_l").qposadr[0]) if free_fingers else None
+    finger_v = int(jnt("finger_l").dofadr[0]) if free_fingers else None
+    object_q = int(jnt("object").qposadr[0]) if kind != "reach" else None
+    object_v = int(jnt("object").dofadr[0]) if kind != "reach" else None
+    (tx, ty, _), (hx, hy, _), home = _SCENES[kind]
+    margin = 0.15
+    lo = (tx - hx - margin, ty - hy - margin, TABLE_TOP + FINGER_BELOW_SITE)
+    hi = (tx + hx + margin, ty + hy + margin, TABLE_TOP + 0.6)
+    rest_z = _rest_height(m, object_q) if object_q is not None else None
+    layout = Layout(
+        grip_q=grip_q,
+        finger_q=finger_q,
+        finger_v=finger_v,
+        object_q=object_q,
+        object_v=object_v,
+        grip_home=tuple(float(x) for x in home),
+        workspace_lo=lo,
+        workspace_hi=hi,
+        object_rest_z=rest_z,
+        nq=int(m.nq),
+        nv=int(m.nv),
+        nu=int(m.nu),
+    )
+    with jax.ensure_compile_time_eval():  # first use may come from inside a jit trace
+        mx = mjx.put_model(m, impl="jax")
+    return m, mx, layout

@@ -1,0 +1,233 @@
+"""Fetch-style MJX tasks: contract and shapes, sampling ranges, validation, rest without drift,
+restore-and-replay bit for bit, NaN flagging, action clipping, and scripted controllers succeeding.
+
+Compiling one MJX rollout takes 10-60 s on a 2-core CPU, so each task compiles exactly one program
+(``_program``: a scan of the batched step whose action is ``actions[t] + w * scripted(obs, goal)``)
+and every physics test reuses it at the same batch size and length.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import chex
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import envs
+from envs.base import InvalidConfig
+from envs.fetch import models, scripted, tasks
+
+NAMES = ["reach", "push", "slide", "pick_and_place"]
+B = 8  # batch of every physics run
+T = 50  # steps of every physics run (one episode)
+K = 20  # restore point of the replay test
+
+
+@functools.cache
+def _env(name):
+    return envs.make(name)
+
+
+@functools.cache
+def _program(name):
+    env, ctl = _env(name), scripted.CONTROLLERS[name]
+
+    @jax.jit
+    def run(state, actions, w):
+        def body(s, a):
+            a = a + w[:, None] * ctl(s.obs, s.desired_goal)
+            s = jax.vmap(env.step)(s, a)
+            return s, s
+
+        return jax.lax.scan(body, state, actions)
+
+    return run
+
+
+@functools.cache
+def _reset(name, n):
+    env = _env(name)
+    return jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, n)))
+
+
+def _run(name, actions, w=0.0, state=None):
+    s0 = _reset(name, B)(jax.random.PRNGKey(0)) if state is None else state
+    return s0, *_program(name)(s0, jnp.asarray(actions, jnp.float32), jnp.full((B,), w, jnp.float32))
+
+
+def _random_actions(seed=1):
+    return jax.random.uniform(jax.random.PRNGKey(seed), (T, B, 4), minval=-1.0, maxval=1.0)
+
+
+def _at(tree, t):
+    return jax.tree_util.tree_map(lambda x: x[t], tree)
+
+
+# ---- cheap: no physics compiled ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_contract_and_shapes_at_batch_2(name):
+    env = _env(name)
+    assert (env.goal_size, env.action_size, env.episode_length) == (3, 4, 50)
+    assert env.obs_size == (10 if name == "reach" else 25)
+    hash(env)  # jitted code closes over tasks: they must stay hashable
+    s = _reset(name, 2)(jax.random.PRNGKey(0))
+    chex.assert_shape(s.obs, (2, env.obs_size))
+    chex.assert_shape([s.achieved_goal, s.desired_goal], (2, 3))
+    chex.assert_shape([s.reward, s.success, s.step, s.invalid], (2,))
+    lay = env.layout
+    chex.assert_shape(s.physics.qpos, (2, lay.nq))
+    chex.assert_shape([s.physics.qvel, s.physics.qacc_warmstart], (2, lay.nv))
+    chex.assert_shape(s.physics.ctrl, (2, lay.nu))
+    assert not bool(s.invalid.any()) and int(s.step.max()) == 0
+    # The step keeps every shape and dtype (traced only, not compiled).
+    out = jax.eval_shape(jax.vmap(env.step), s, jnp.zeros((2, 4)))
+    chex.assert_trees_all_equal_shapes_and_dtypes(out, s)
+    # Achieved goal, layout and reward convention.
+    np.testing.assert_array_equal(s.achieved_goal, s.obs[:, 0:3] if name == "reach" else s.obs[:, 3:6])
+    np.testing.assert_allclose(s.obs[:, 0:3], np.broadcast_to(lay.grip_home, (2, 3)), atol=1e-6)
+    np.testing.assert_array_equal(s.reward, env.reward_of(s.achieved_goal, s.desired_goal))
+    near = jax.vmap(env.with_goal)(s, s.achieved_goal + jnp.asarray([0.0, 0.0, 0.049]))
+    far = jax.vmap(env.with_goal)(s, s.achieved_goal + jnp.asarray([0.0, 0.0, 0.051]))
+    assert bool(near.success.all()) and not bool(far.success.any())
+    np.testing.assert_array_equal(near.reward, 0.0)
+    np.testing.assert_array_equal(far.reward, -1.0)
+    jax.tree_util.tree_map(np.testing.assert_array_equal, near.physics, s.physics)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_reset_samples_stay_in_their_ranges(name):
+    env = _env(name)
+    n = 4000
+    s = _reset(name, n)(jax.random.PRNGKey(3))
+    home = np.asarray(env.layout.grip_home)
+    goal = np.asarray(s.desired_goal)
+    offset = np.asarray(env.target_offset)
+    tr = env.target_range
+    assert np.all(np.abs(goal[:, :2] - home[:2] - offset[:2]) <= tr + 1e-6)
+    if name == "reach":
+        assert np.all(np.abs(goal - home) <= tr + 1e-6)
+        return
+    obj = np.asarray(s.achieved_goal)
+    d = np.linalg.norm(obj[:, :2] - home[:2], axis=-1)
+    assert np.all(np.abs(obj[:, :2] - home[:2]) <= env.obj_range + 1e-6)
+    assert np.all(d >= tasks.MIN_OBJECT_DISTANCE - 1e-6)
+    rest = env.layout.object_rest_z
+    np.testing.assert_allclose(obj[:, 2], rest, atol=1e-6)
+    lift = goal[:, 2] - rest
+    if name == "pick_and_place":
+        air = lift > 1e-6
+        assert 0.45 < air.mean() < 0.55
+        assert np.all(lift >= -1e-6) and np.all(lift <= tasks.GOAL_LIFT_MAX + 1e-6)
+    else:
+        np.testing.assert_allclose(lift, 0.0, atol=1e-6)
+    # Uniform over the allowed region: the spread reaches close to the range on each side.
+    assert np.ptp(obj[:, 0]) > 1.8 * env.obj_range and np.ptp(goal[:, 1]) > 1.8 * tr
+
+
+@pytest.mark.parametrize(
+    ("name", "field", "value"),
+    [
+        ("push", "distance_threshold", 0.0),
+        ("push", "obj_range", -0.1),
+        ("push", "obj_range", 0.05),  # no room for the 0.1 m minimum distance
+        ("slide", "target_range", -0.3),
+        ("pick_and_place", "substeps", 0),
+        ("reach", "timestep", 0.0),
+        ("push", "iterations", 0),
+        ("reach", "max_episode_steps", 0),
+    ],
+)
+def test_bad_overrides_fail_naming_the_field(name, field, value):
+    with pytest.raises(InvalidConfig, match=rf"{name}\.{field}"):
+        envs.make(name, **{field: value})
+
+
+def test_unknown_override_fails_naming_it():
+    with pytest.raises(InvalidConfig, match=r"push\.friction"):
+        envs.make("push", friction=1.0)
+
+
+def test_euler_angles_match_the_rotation():
+    a, b, c = 0.3, -0.5, 1.1
+    half = lambda axis, t: jnp.concatenate([jnp.cos(t / 2)[None], jnp.sin(t / 2) * jnp.asarray(axis)])  # noqa: E731
+
+    def mul(p, q):
+        w1, v1, w2, v2 = p[0], p[1:], q[0], q[1:]
+        return jnp.concatenate([(w1 * w2 - v1 @ v2)[None], w1 * v2 + w2 * v1 + jnp.cross(v1, v2)])
+
+    q = mul(mul(half([1.0, 0, 0], a), half([0, 1.0, 0], b)), half([0, 0, 1.0], c))  # R = Rx Ry Rz
+    np.testing.assert_allclose(tasks.quat_to_euler(q), [a, b, c], atol=1e-5)
+
+
+def test_model_has_only_listed_contact_pairs():
+    for kind in models.KINDS:
+        m = models.build(kind)[0]
+        assert not m.geom_contype.any() and not m.geom_conaffinity.any()
+        assert m.npair == {"reach": 0, "push": 3, "slide": 3, "pick_and_place": 4}[kind]
+
+
+# ---- physics: one compiled program per task --------------------------------------------------------
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", NAMES)
+def test_rests_without_drift_under_zero_action(name):
+    s0, _, traj = _run(name, np.zeros((T, B, 4)))
+    assert not bool(traj.invalid.any())
+    drift = np.abs(np.asarray(traj.achieved_goal) - np.asarray(s0.achieved_goal)[None])
+    assert drift.max() < 2e-3, drift.max()
+    np.testing.assert_array_equal(traj.step[-1], T)
+    assert np.abs(np.asarray(traj.obs[-1])[:, -5:]).max() < 1e-3  # velocities settle
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", NAMES)
+def test_restore_and_replay_is_bitwise_exact(name):
+    acts = _random_actions()
+    _, _, traj = _run(name, acts)
+    saved = _at(traj, K - 1)  # the state after K steps
+    replay = jnp.concatenate([acts[K:], acts[:K]])  # same length: same compiled program
+    _, _, again = _run(name, replay, state=saved)
+    first, second = _at(traj, slice(K, T)), _at(again, slice(0, T - K))
+    jax.tree_util.tree_map(np.testing.assert_array_equal, first, second)
+    assert not bool(traj.invalid.any())
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["push", "pick_and_place"])
+def test_actions_are_clipped_and_observation_is_consistent(name):
+    acts = _random_actions(2) * 5.0
+    _, _, clipped = _run(name, jnp.clip(acts, -1.0, 1.0))
+    _, _, big = _run(name, acts)
+    np.testing.assert_array_equal(clipped.obs, big.obs)
+    # The gripper did move: random actions shift it from home.
+    obs = np.asarray(big.obs)
+    assert np.abs(obs[-1, :, 0:3] - obs[0, :, 0:3]).max() > 0.02
+    np.testing.assert_allclose(obs[..., 6:9], obs[..., 3:6] - obs[..., 0:3], atol=1e-6)
+    d = np.linalg.norm(np.asarray(big.achieved_goal - big.desired_goal), axis=-1)
+    np.testing.assert_array_equal(big.reward, -(d >= 0.05).astype(np.float32))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["reach", "push"])
+def test_nan_action_is_flagged(name):
+    acts = np.asarray(_random_actions(3)).copy()
+    acts[3, 1, 0] = np.nan
+    _, _, traj = _run(name, acts)
+    invalid = np.asarray(traj.invalid)
+    assert not invalid[:, 0].any()  # the other episode is untouched
+    assert not invalid[:3, 1].any() and invalid[3:, 1].all()  # flagged from the bad step on, and stays
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("name", "need"), [("reach", 1.0), ("push", 0.75), ("pick_and_place", 0.75), ("slide", 0.25)])
+def test_scripted_controllers_succeed_in_most_episodes(name, need):
+    _, final, traj = _run(name, np.zeros((T, B, 4)), w=1.0)
+    reached = np.asarray(traj.success).any(axis=0)
+    assert reached.mean() >= need, reached
+    assert not bool(traj.invalid.any())
