@@ -140,11 +140,12 @@ def main(argv=None) -> int:
         "date": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d"),
         "device": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores (MuJoCo C)",
         "versions": {"gymnasium_robotics": gymnasium_robotics.__version__, "mujoco": mujoco.__version__},
+        "load_average_at_start": os.getloadavg(),
         "episodes": args.episodes,
         "seed": args.seed,
         "tasks": {},
     }
-    for task in args.tasks.split(","):
+    for task in filter(None, args.tasks.split(",")):
         t0 = time.perf_counter()
         recs = run_episodes(task, args.episodes, args.seed)
         secs = time.perf_counter() - t0
@@ -154,6 +155,7 @@ def main(argv=None) -> int:
         print(f"{task:15s} success any-step {sa:.3f} final-step {sf:.3f}  ({len(recs)} episodes, {secs:.0f} s)")
     if args.bench_steps > 0:
         out["throughput"] = bench(TASKS[args.bench_task], args.bench_steps, args.procs)
+        out["throughput"]["load_average_after"] = os.getloadavg()
         b = out["throughput"]
         print(f"throughput {b['env']}: {b['single_process_steps_per_s']:.0f} env-steps/s on 1 process, "
               f"{b['multi_process_steps_per_s']:.0f} on {b['procs']} ({b['speedup']:.2f}x)")
