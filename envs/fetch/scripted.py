@@ -182,23 +182,31 @@ def slide(obs, goal, gain=SLIDE_GAIN, friction=SLIDE_FRICTION, push_gain=SLIDE_P
     return _with_fingers(move, -1.0)
 
 
-def pick_and_place(obs, goal):
-    """Open, go above the cube, descend, close, then carry it to ``goal`` (on the table or in the air)."""
+GRASP_DEPTH = 0.004  # close the fingers once the grip site is at most this far above the cube's centre
+CARRY_MAX = 1.0  # largest action component while carrying
+
+
+def pick_and_place(obs, goal, carry_max=CARRY_MAX):
+    """Open, go above the cube, descend as deep as the fingers allow, close, then carry it to ``goal``
+    (on the table or in the air)."""
     obs, grip, obj, goal = _parts(obs, goal)
     width = obs[..., 9] + obs[..., 10]  # finger opening: 0 closed, 0.1 fully open
     rel = obj - grip
     xy_off = _norm(rel[..., :2])[..., 0]
-    z_off = jnp.abs(rel[..., 2])
-    at_object = (xy_off < 0.015) & (z_off < 0.015)
-    holding = at_object & (width < 2 * CUBE_HALF + 0.012) & (width > 2 * CUBE_HALF - 0.02)
+    height = -rel[..., 2]  # grip site above the cube's centre
+    # Close only when deep: fingers closed on the cube's top edge hold it poorly.
+    at_object = (xy_off < 0.015) & (height < GRASP_DEPTH) & (height > -0.03)
+    near = (xy_off < 0.02) & (jnp.abs(height) < 0.025)
+    holding = near & (width < 2 * CUBE_HALF + 0.012) & (width > 2 * CUBE_HALF - 0.02)
     is_open = width > 0.08
 
     # Carry: move the gripper so that the object (not the gripper) lands on the goal.
-    carry = _toward(grip, goal - rel)
+    carry = jnp.clip(_toward(grip, goal - rel), -carry_max, carry_max)
     hold = jnp.zeros_like(grip)
-    # Above the object and open: descend onto it; not open yet: wait there.
+    # Above the object and open: descend (aiming below its centre: the table or the fingers stop the
+    # gripper); not open yet: wait there.
     above = xy_off < 0.01
-    descend = _toward(grip, obj)
+    descend = _toward(grip, obj - jnp.asarray([0.0, 0.0, 0.02], jnp.float32))
     hover = obj + jnp.asarray([0.0, 0.0, CLEARANCE], jnp.float32)
     # Travel at the hover height; when low and off to the side, rise before moving across.
     low = grip[..., 2] < obj[..., 2] + CLEARANCE - 0.02

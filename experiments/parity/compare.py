@@ -22,6 +22,7 @@ FLAG_POINTS = 5.0  # a success difference above this many points is flagged
 QUANTITIES = (
     ("object start x", lambda r: r["object_start"][0]),
     ("object start y", lambda r: r["object_start"][1]),
+    ("object start z", lambda r: r["object_start"][2]),
     ("goal x", lambda r: r["goal"][0]),
     ("goal y", lambda r: r["goal"][1]),
     ("goal z", lambda r: r["goal"][2]),
@@ -82,8 +83,8 @@ def plot(ours, ref, tasks, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    cols = (("object start x", 0), ("object start y", 1), ("goal x", 2), ("goal y", 3), ("goal z", 4),
-            ("|displacement| xy", 8), ("final distance to goal", 9))
+    cols = (("object start x", 0), ("object start y", 1), ("goal x", 3), ("goal y", 4), ("goal z", 5),
+            ("|displacement| xy", 9), ("final distance to goal", 10))
     fig, axes = plt.subplots(len(tasks), len(cols), figsize=(3 * len(cols), 2.4 * len(tasks)), squeeze=False)
     for i, t in enumerate(tasks):
         for j, (name, q) in enumerate(cols):
@@ -91,6 +92,8 @@ def plot(ours, ref, tasks, path):
             a = [fn(x) for x in ours["tasks"][t]["episodes"]]
             b = [fn(x) for x in ref["tasks"][t]["episodes"]]
             lo, hi = min(min(a), min(b)), max(max(a), max(b))
+            if hi - lo < 0.01:  # (nearly) constant: widen, so sub-millimetre float noise shows as one bar
+                lo, hi = (lo + hi) / 2 - 0.01, (lo + hi) / 2 + 0.01
             bins = np.linspace(lo, hi + 1e-9, 25)
             ax = axes[i, j]
             ax.hist(b, bins=bins, alpha=0.5, label="reference")
@@ -175,7 +178,7 @@ def main(argv=None) -> int:
                   "| run | device | overrides | " + " | ".join(tasks) + " |",
                   "|---|---|---|" + "---|" * len(tasks)]
         for item in args.also:
-            label, _, path = item.partition("=")
+            label, _, path = item.rpartition("=")
             run = json.loads(Path(path).read_text())
             cells = []
             for t in tasks:
