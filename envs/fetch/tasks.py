@@ -15,13 +15,25 @@ Newton solver's warm start. ``step`` rebuilds an ``mjx.Data`` from it, so restor
 and replaying the same actions reproduces the saved trajectory bit for bit.
 
 Defaults: 10 substeps of 4 ms (the reference takes 20 of 2 ms), Newton with 4 iterations and 4
-line-search iterations (Slide: 10 iterations, as with 4 a resting low-friction puck crept up to 10 cm
-in 50 steps in float32 MJX, while MuJoCo C held it still; 10 cost about 10% there). Measured on CPU with MuJoCo C on these models, scripted push over 200
-episodes: success 0.76 to 0.83 at 20 x 2 ms (10 or 4 iterations), 0.72 at 10 x 4 ms, 0.58 at
-4 x 10 ms; a centred push with a = (0.6, 0, 0) for 6 steps moves the cube 10.0 cm at 20 x 2 ms,
-10.4 cm at 10 x 4 ms and 13.0 cm at 4 x 10 ms. 10 x 4 ms keeps the contact behaviour within the
-spread that solver settings alone cause at 2 ms and halves the cost; 4 x 10 ms does not. Both are
-task fields (``timestep``, ``substeps``), as are the solver's ``iterations`` and ``ls_iterations``.
+line-search iterations (Slide: 10 iterations; with 4 a resting low-friction puck crept up to 10 cm
+in 50 steps in float32 MJX while MuJoCo C held it still; 10 showed no measurable cost at batch 64
+on CPU). Both are task fields (``timestep``, ``substeps``, ``iterations``, ``ls_iterations``).
+Measured on CPU on these models, per timing 20 x 2 / 10 x 4 / 4 x 10 ms:
+
+- a crude scripted push, MuJoCo C, 200 episodes: success 0.76-0.83 (10 or 4 iterations) / 0.72 /
+  0.58; a centred push, a = (0.6, 0, 0) for 6 steps, moves the cube 10.0 / 10.4 / 13.0 cm.
+- ``envs.fetch.scripted.push``, 100 episodes, final success: MuJoCo C 1.00 / 0.99 / 0.99, MJX
+  1.00 / 1.00 / 0.97 (median final error 0.36-0.58 cm).
+- ``envs.fetch.scripted.slide``, 100 episodes, final success: MuJoCo C 0.28 / 0.37 / 0.56, MJX
+  0.50 / 0.46 / 0.60 with NaN in some episodes (MuJoCo C warned of instability too). A freely
+  sliding puck travels the same in both (0.5075 / 0.5076 m from 1 m/s), so the gap lies in the
+  pusher-puck impacts, whose box-box contacts MuJoCo C and MJX generate differently.
+- ``envs.fetch.scripted.pick_and_place``, 50 episodes, final success: MuJoCo C and MJX both
+  1.00 / 1.00 / 0.00 (median error 0.21 cm): at 10 ms the finger drive (kp 30000) is unstable.
+
+10 x 4 ms keeps the contact behaviour within the spread that solver settings alone cause at 2 ms
+and halves the cost; 4 x 10 ms moves pushed objects further, is unstable on Slide and breaks
+PickAndPlace.
 """
 
 from __future__ import annotations
