@@ -1,4 +1,5 @@
-"""Speed of the SPLID iteration on one device: SELECT verdicts per second, chunk time, compile
+"""Speed of the SPLID iteration on one device: SELECT verdicts per second (valid candidates decided
+by a replay) and replays per second, chunk time, compile
 time, and the cost of vmapping seeds, each against a peer measured in the same run.
 
     python experiments/bench_splid.py --env push --num-envs 64,256,1024 --seeds 8 --out bench.json
@@ -20,7 +21,7 @@ import jax.numpy as jnp
 
 from splid_jax.config import TrainConfig
 from splid_jax.explore import explore
-from splid_jax.select import select
+from splid_jax.select import replay_slots, select
 from splid_jax.train import make_env
 from splid_jax.trainer import Trainer
 
@@ -46,17 +47,32 @@ def bench_select(env, cfg: TrainConfig, device, repeats: int) -> dict:
         traj = jax.jit(lambda ps, k: explore(env, trainer.policy, ps, k, cfg.num_envs, jnp.float32(cfg.sigma)))(
             state.policy, jax.random.PRNGKey(1)
         )
-        fn = jax.jit(lambda ps, tr: select(env, trainer.policy, ps, tr, cfg.horizon, jnp.int32(cfg.horizon), True))
+        fn = jax.jit(
+            lambda ps, tr: select(
+                env,
+                trainer.policy,
+                ps,
+                tr,
+                cfg.horizon,
+                jnp.int32(cfg.horizon),
+                True,
+                jax.random.PRNGKey(2),
+                cfg.select_budget,
+            )
+        )
         out = timed(fn, state.policy, traj, repeats=repeats)
         cands = fn(state.policy, traj)
     T, H, N = env.episode_length, cfg.horizon, cfg.num_envs
-    verdicts = N * sum(T - h + 1 for h in range(1, H + 1))
+    slots = replay_slots(T, N, cfg.select_budget) * H  # candidates replayed, valid or filler
+    verdicts = int(cands.valid.sum()) - int(cands.dropped)  # valid candidates decided by a replay
     out.update(
         device=str(device),
         num_envs=N,
-        verdicts=verdicts,
+        select_budget=cfg.select_budget,
         valid=int(cands.valid.sum()),
+        verdicts=verdicts,
         verdicts_per_s=verdicts / out["median_s"],
+        replays_per_s=slots / out["median_s"],
         replay_steps_per_s=trainer.counters(1)["select_steps"] / out["median_s"],
     )
     return out
@@ -109,7 +125,8 @@ def main() -> None:
         r = bench_select(env, cfg, dev, a.repeats)
         res["select"].append(r)
         print(
-            f"SELECT {dev.platform} N={n}: {r['verdicts_per_s']:,.0f} verdicts/s, "
+            f"SELECT {dev.platform} N={n}: {r['verdicts_per_s']:,.0f} verdicts/s ({r['verdicts']} valid decided), "
+            f"{r['replays_per_s']:,.0f} replays/s, "
             f"{r['replay_steps_per_s']:,.0f} replay steps/s, {r['median_s']:.3f}s, compile {r['compile_s']:.1f}s",
             flush=True,
         )

@@ -24,6 +24,9 @@ class TrainConfig:
     sigma: float = _f(1.0, "std of the Gaussian exploration noise added to the policy's action")
     horizon: int = _f(8, "learning horizon H: hindsight goals come from 1..H steps ahead")
     select: bool = _f(True, "SELECT by first hit time; --no-select stores every relabelled pair (ablation)")
+    select_budget: float = _f(
+        None, "fraction of the T x N starts SELECT replays per h, filled with valid candidates at random (1: all)"
+    )
     buffer_size: int = _f(None, "relabel buffer capacity (FIFO)")
     batch_size: int = _f(None, "behaviour-cloning minibatch size")
     bc_steps: int = _f(None, "behaviour-cloning gradient steps per iteration")
@@ -46,6 +49,7 @@ class TrainConfig:
         check(self.num_envs >= 1, "num_envs", self.num_envs, "an integer >= 1")
         check(self.sigma >= 0, "sigma", self.sigma, ">= 0")
         check(self.horizon >= 1, "horizon", self.horizon, "an integer >= 1 (and < the episode length)")
+        check(0 < self.select_budget <= 1, "select_budget", self.select_budget, "in (0, 1]")
         check(self.buffer_size >= 1, "buffer_size", self.buffer_size, "an integer >= 1")
         check(self.batch_size >= 1, "batch_size", self.batch_size, "an integer >= 1")
         check(self.bc_steps >= 0, "bc_steps", self.bc_steps, "an integer >= 0")
@@ -79,6 +83,7 @@ class TrainConfig:
 
 _POINT = dict(
     iterations=100,
+    select_budget=1.0,
     num_envs=32,
     buffer_size=200_000,
     batch_size=256,
@@ -90,6 +95,7 @@ _POINT = dict(
 )
 _FETCH = dict(
     iterations=200,
+    select_budget=0.35,
     num_envs=256,
     buffer_size=1_000_000,
     batch_size=1024,

@@ -27,7 +27,8 @@ class Candidates(NamedTuple):
     goal: jax.Array  # [M, G]
     action: jax.Array  # [M, A]
     valid: jax.Array  # [M] a real candidate: t + h <= T, the goal moved, no NaN, h <= horizon
-    accept: jax.Array  # [M] valid and not solved by the current policy within h steps
+    accept: jax.Array  # [M] valid, replayed, and not solved by the current policy within h steps
+    dropped: jax.Array  # [] int32, valid candidates left undecided because the replay budget was full
 
 
 def policy_reaches(env: GoalEnv, policy: Policy, pstate: PolicyState, state: State, goal: jax.Array, h):
@@ -47,9 +48,14 @@ def num_candidates(episode_length: int, max_horizon: int, num_envs: int) -> int:
     return max_horizon * episode_length * num_envs
 
 
-def replay_steps(episode_length: int, horizon: int, num_envs: int) -> int:
-    """Simulator steps SELECT takes per iteration: h steps for each of the T x N starts, per h."""
-    return num_envs * episode_length * horizon * (horizon + 1) // 2
+def replay_slots(episode_length: int, num_envs: int, budget: float) -> int:
+    """Candidates replayed per h: all T x N starts, or the ``budget`` fraction of them."""
+    return max(1, min(episode_length * num_envs, int(round(budget * episode_length * num_envs))))
+
+
+def replay_steps(episode_length: int, horizon: int, num_envs: int, budget: float = 1.0) -> int:
+    """Simulator steps SELECT takes per iteration: h steps for each replayed slot, per h."""
+    return replay_slots(episode_length, num_envs, budget) * horizon * (horizon + 1) // 2
 
 
 def select(
@@ -60,10 +66,17 @@ def select(
     max_horizon: int,
     horizon: jax.Array,
     use_select: bool,
+    key: jax.Array | None = None,
+    budget: float = 1.0,
 ) -> Candidates:
     """``max_horizon`` fixes the shapes; ``horizon`` (traced, <= max_horizon) masks and skips
     the replays of larger h, so runs with different H share one compiled program.
-    ``use_select=False`` is the ablation: every valid pair is stored, nothing is replayed."""
+    ``use_select=False`` is the ablation: every valid pair is stored, nothing is replayed.
+
+    ``budget`` < 1 replays, per h, only that fraction of the T x N slots, filled with valid
+    candidates chosen uniformly at random (``key``): most candidates of object tasks are invalid
+    (the object did not move), and replaying them is wasted work. Valid candidates beyond the
+    budget are left undecided (not stored) and counted in ``dropped``."""
     T, H = env.episode_length, max_horizon
     n = traj.actions.shape[1]
     hs = jnp.arange(1, H + 1)
@@ -78,17 +91,37 @@ def select(
         & (hs <= horizon)[:, None, None]
     ).reshape(-1)
     goal = goal.reshape(H, T * n, -1)
+    dropped = jnp.int32(0)
     if use_select:
         starts = jax.tree_util.tree_map(lambda x: x.reshape((T * n,) + x.shape[2:]), traj.states)
         replay = jax.vmap(lambda s, g, h: policy_reaches(env, policy, pstate, s, g, h), in_axes=(0, 0, None))
+        slots = replay_slots(T, n, budget)
+        if slots < T * n:
+            key = jax.random.PRNGKey(0) if key is None else key
+            valid_h = valid.reshape(H, T * n)
+            # a random priority among valid candidates; invalid ones sort last
+            score = jax.random.uniform(key, valid_h.shape) + valid_h.astype(jnp.float32)
+            chosen = jax.lax.top_k(score, slots)[1]  # [H, slots]
+            decided = jnp.zeros_like(valid_h).at[jnp.arange(H)[:, None], chosen].set(True) & valid_h
+            dropped = jnp.sum(valid_h & ~decided, dtype=jnp.int32)
 
-        def per_h(_, xs):
-            h, goal_h = xs
-            return None, replay(starts, goal_h, jnp.where(h <= horizon, h, 0))
+            def per_h(_, xs):
+                h, goal_h, idx = xs
+                picked = jax.tree_util.tree_map(lambda x: x[idx], starts)
+                hit = replay(picked, goal_h[idx], jnp.where(h <= horizon, h, 0))
+                return None, jnp.zeros(T * n, bool).at[idx].set(hit)
 
-        _, reached = jax.lax.scan(per_h, None, (hs, goal))
-        accept = valid & ~reached.reshape(-1)
+            _, reached = jax.lax.scan(per_h, None, (hs, goal, chosen))
+            accept = decided.reshape(-1) & ~reached.reshape(-1)
+        else:
+
+            def per_h(_, xs):
+                h, goal_h = xs
+                return None, replay(starts, goal_h, jnp.where(h <= horizon, h, 0))
+
+            _, reached = jax.lax.scan(per_h, None, (hs, goal))
+            accept = valid & ~reached.reshape(-1)
     else:
         accept = valid
     tile = lambda x: jnp.broadcast_to(x[None], (H,) + x.shape).reshape((H * T * n,) + x.shape[2:])  # noqa: E731
-    return Candidates(tile(traj.states.obs), goal.reshape(H * T * n, -1), tile(traj.actions), valid, accept)
+    return Candidates(tile(traj.states.obs), goal.reshape(H * T * n, -1), tile(traj.actions), valid, accept, dropped)

@@ -67,9 +67,11 @@ class Trainer:
 
     def iteration(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
         env, cfg, policy = self.env, self.cfg, self.policy
-        key, k_explore, k_bc = jax.random.split(ts.key, 3)
+        key, k_explore, k_select, k_bc = jax.random.split(ts.key, 4)
         traj = explore(env, policy, ts.policy, k_explore, cfg.num_envs, hyper.sigma)
-        cands = select(env, policy, ts.policy, traj, self.max_horizon, hyper.horizon, cfg.select)
+        cands = select(
+            env, policy, ts.policy, traj, self.max_horizon, hyper.horizon, cfg.select, k_select, cfg.select_budget
+        )
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
         pstate = policy.update_normaliser(ts.policy, traj.states.obs, traj.achieved[:-1])
         pstate, opt_state, loss = bc_epoch(
@@ -78,6 +80,7 @@ class Trainer:
         metrics = {
             "select_pairs": jnp.sum(cands.valid, dtype=jnp.int32),
             "select_accepted": jnp.sum(cands.accept, dtype=jnp.int32),
+            "select_dropped": cands.dropped,
             "bc_loss": loss,
             "explore_success": jnp.mean(jnp.any(traj.states.success, axis=0)),
         }
@@ -92,6 +95,7 @@ class Trainer:
         metrics.update(
             select_pairs=jnp.sum(per_iter["select_pairs"]),
             select_accepted=jnp.sum(per_iter["select_accepted"]),
+            select_dropped=jnp.sum(per_iter["select_dropped"]),
             bc_loss=per_iter["bc_loss"][-1],
             explore_success=jnp.mean(per_iter["explore_success"]),
             buffer_size=ts.buffer.size,
@@ -103,7 +107,7 @@ class Trainer:
         """Work done after ``iteration`` iterations, as exact Python ints (no int32 overflow)."""
         cfg, T = self.cfg, self.env.episode_length
         h = cfg.horizon if horizon is None else horizon
-        per_iter = replay_steps(T, h, cfg.num_envs) if cfg.select else 0
+        per_iter = replay_steps(T, h, cfg.num_envs, cfg.select_budget) if cfg.select else 0
         return {
             "iteration": iteration,
             "episodes": iteration * cfg.num_envs,

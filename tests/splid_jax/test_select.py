@@ -97,3 +97,23 @@ def test_explore_shapes_and_noise(env):
     assert float(jnp.std(traj.actions)) > 0.3 and float(jnp.max(jnp.abs(traj.actions))) <= 1.0
     quiet = explore(env, policy, pstate, jax.random.PRNGKey(0), 4, jnp.float32(0.0))
     np.testing.assert_array_equal(quiet.actions, 0.0)
+
+
+def test_replay_budget_decides_a_random_subset_of_valid_candidates(env):
+    policy, pstate = constant_policy(env, [1.0, 0.0])
+    starts = jnp.full((3, 2), -4.8)
+    traj = scripted_trajectory(env, starts, jnp.array([[0.4, 0.0], [0.0, 0.4], [0.3, 0.3]]))
+    full = select(env, policy, pstate, traj, H, jnp.int32(H), True)
+    valid_per_h = np.asarray(full.valid).reshape(H, -1).sum(axis=1)
+    # a budget with room for every valid candidate decides exactly what the full replay decides
+    roomy = select(env, policy, pstate, traj, H, jnp.int32(H), True, jax.random.PRNGKey(1), 0.9)
+    assert valid_per_h.max() <= round(0.9 * T * 3)
+    np.testing.assert_array_equal(roomy.accept, full.accept)
+    assert int(roomy.dropped) == 0
+    # a tight budget replays 3 slots per h: the rest of the valid candidates are dropped, never stored
+    tight = select(env, policy, pstate, traj, H, jnp.int32(H), True, jax.random.PRNGKey(1), 0.1)
+    decided = np.minimum(valid_per_h, 3).sum()
+    assert int(tight.dropped) == valid_per_h.sum() - decided
+    accept = np.asarray(tight.accept)
+    assert not (accept & ~np.asarray(full.accept)).any()  # a stored pair is one the full replay accepts
+    assert 0 < accept.sum() <= decided
