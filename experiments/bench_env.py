@@ -7,6 +7,10 @@ program's argument/output/temporary bytes (XLA's memory analysis, any device) an
 bytes in use where the device reports it (GPUs). A batch that fails (e.g. out of memory) is recorded
 with its error and the larger batches of that task and variant are skipped.
 
+On a 2-core CPU (jax 0.10.2, batch 64, 20 steps) it measured, in control steps/s at the default
+10 x 4 ms and at 20 x 2 ms: reach 59,500 / 26,600, push 1,720 / 760, slide 960 / 540,
+pick_and_place 880 / 500; compile 6 s (reach) to 28 s (pick_and_place).
+
 Examples::
 
     python experiments/bench_env.py --batch 4 --steps 5 --repeats 2           # CPU smoke test
