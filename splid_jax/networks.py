@@ -64,11 +64,17 @@ class Policy:
         """The deterministic action the environment receives."""
         return jnp.clip(self.mean(pstate, obs, goal), -1.0, 1.0)
 
-    def update_normaliser(self, pstate: PolicyState, obs: jax.Array, goal: jax.Array) -> PolicyState:
+    def update_normaliser(
+        self, pstate: PolicyState, obs: jax.Array, goal: jax.Array, valid: jax.Array | None = None
+    ) -> PolicyState:
+        """Fold a batch into the running statistics; rows where ``valid`` is False (a NaN was
+        seen in that episode) carry no weight and are zeroed, since 0 * NaN would still poison them."""
         if not self.normalise:
             return pstate
         x = jnp.concatenate([obs, goal], axis=-1).reshape(-1, self.in_size)
-        return pstate.replace(normaliser=running_statistics.update(pstate.normaliser, x))
+        w = jnp.ones(x.shape[0], jnp.float32) if valid is None else valid.reshape(-1).astype(jnp.float32)
+        x = jnp.where(w[:, None] > 0, x, 0.0)
+        return pstate.replace(normaliser=running_statistics.update(pstate.normaliser, x, weights=w))
 
 
 def make_policy(obs_size: int, goal_size: int, action_size: int, hidden: Sequence[int], normalise: bool) -> Policy:

@@ -73,7 +73,7 @@ class Trainer:
             env, policy, ts.policy, traj, self.max_horizon, hyper.horizon, cfg.select, k_select, cfg.select_budget
         )
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
-        pstate = policy.update_normaliser(ts.policy, traj.states.obs, traj.achieved[:-1])
+        pstate = policy.update_normaliser(ts.policy, traj.states.obs, traj.achieved[:-1], ~traj.invalid[:-1])
         pstate, opt_state, loss = bc_epoch(
             policy, self.optimiser, pstate, ts.opt_state, buf, k_bc, cfg.bc_steps, cfg.batch_size
         )

@@ -35,3 +35,15 @@ def test_empty_buffer_leaves_parameters_unchanged():
     buf = relabel_buffer.init(16, 2, 2, 2)
     new, _, _ = bc_epoch(policy, opt, pstate, opt.init(pstate.params), buf, jax.random.PRNGKey(0), 5, 8)
     chex.assert_trees_all_equal(new.params, pstate.params)
+
+
+def test_normaliser_ignores_rows_flagged_invalid():
+    policy = make_policy(2, 2, 2, (8,), normalise=True)
+    pstate = policy.init(jax.random.PRNGKey(0))
+    obs = jnp.array([[1.0, 2.0], [jnp.nan, jnp.nan], [3.0, 4.0]])
+    goal = jnp.zeros((3, 2))
+    new = policy.update_normaliser(pstate, obs, goal, jnp.array([True, False, True]))
+    clean = policy.update_normaliser(pstate, obs[jnp.array([0, 2])], goal[:2])
+    chex.assert_trees_all_close(new.normaliser.mean, clean.normaliser.mean)
+    chex.assert_trees_all_close(new.normaliser.std, clean.normaliser.std)
+    assert bool(jnp.all(jnp.isfinite(policy.act(new, obs[:1], goal[:1]))))
