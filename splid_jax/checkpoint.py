@@ -111,12 +111,13 @@ def latest_step(run_dir: str | Path) -> int | None:
 
 
 def _first_meta_diff(saved: Any, expected: Any, key: str = "") -> tuple[str, Any, Any] | None:
-    """First differing dotted key with both values; nested dicts are walked so the key is precise."""
+    """First differing dotted key with both values; nested dicts are walked so the key is precise.
+    Only the keys of ``expected`` are checked: the saved meta may carry more (progress, timings)."""
     if isinstance(saved, dict) and isinstance(expected, dict):
-        for k in [*expected, *(k for k in saved if k not in expected)]:
+        for k in expected:
             sub = f"{key}.{k}" if key else str(k)
-            if k not in saved or k not in expected:
-                return sub, saved.get(k, _MISSING), expected.get(k, _MISSING)
+            if k not in saved:
+                return sub, _MISSING, expected[k]
             diff = _first_meta_diff(saved[k], expected[k], sub)
             if diff is not None:
                 return diff
