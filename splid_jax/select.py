@@ -95,32 +95,27 @@ def select(
     if use_select:
         starts = jax.tree_util.tree_map(lambda x: x.reshape((T * n,) + x.shape[2:]), traj.states)
         replay = jax.vmap(lambda s, g, h: policy_reaches(env, policy, pstate, s, g, h), in_axes=(0, 0, None))
+        valid_h = valid.reshape(H, T * n)
         slots = replay_slots(T, n, budget)
         if slots < T * n:
             key = jax.random.PRNGKey(0) if key is None else key
-            valid_h = valid.reshape(H, T * n)
             # a random priority among valid candidates; invalid ones sort last
             score = jax.random.uniform(key, valid_h.shape) + valid_h.astype(jnp.float32)
             chosen = jax.lax.top_k(score, slots)[1]  # [H, slots]
             decided = jnp.zeros_like(valid_h).at[jnp.arange(H)[:, None], chosen].set(True) & valid_h
             dropped = jnp.sum(valid_h & ~decided, dtype=jnp.int32)
-
-            def per_h(_, xs):
-                h, goal_h, idx = xs
-                picked = jax.tree_util.tree_map(lambda x: x[idx], starts)
-                hit = replay(picked, goal_h[idx], jnp.where(h <= horizon, h, 0))
-                return None, jnp.zeros(T * n, bool).at[idx].set(hit)
-
-            _, reached = jax.lax.scan(per_h, None, (hs, goal, chosen))
-            accept = decided.reshape(-1) & ~reached.reshape(-1)
         else:
+            chosen = jnp.broadcast_to(jnp.arange(T * n), (H, T * n))
+            decided = valid_h
 
-            def per_h(_, xs):
-                h, goal_h = xs
-                return None, replay(starts, goal_h, jnp.where(h <= horizon, h, 0))
+        def per_h(_, xs):
+            h, goal_h, idx = xs
+            picked = jax.tree_util.tree_map(lambda x: x[idx], starts)
+            hit = replay(picked, goal_h[idx], jnp.where(h <= horizon, h, 0))
+            return None, jnp.zeros(T * n, bool).at[idx].set(hit)
 
-            _, reached = jax.lax.scan(per_h, None, (hs, goal))
-            accept = valid & ~reached.reshape(-1)
+        _, reached = jax.lax.scan(per_h, None, (hs, goal, chosen))
+        accept = (decided & ~reached).reshape(-1)
     else:
         accept = valid
     tile = lambda x: jnp.broadcast_to(x[None], (H,) + x.shape).reshape((H * T * n,) + x.shape[2:])  # noqa: E731

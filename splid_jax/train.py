@@ -45,7 +45,8 @@ def _record(trainer: Trainer, metrics: dict, wall_s: float, chunk_s: float, iter
     rec = trainer.counters(iteration)
     for k, v in metrics.items():
         rec[k] = v.item()
-    steps = trainer.cfg.eval_every * (trainer.counters(1)["env_steps"] + trainer.counters(1)["select_steps"])
+    one = trainer.counters(1)
+    steps = trainer.cfg.eval_every * (one["env_steps"] + one["select_steps"])
     rec["buffer_fill"] = rec["buffer_size"] / trainer.cfg.buffer_size
     rec["steps_per_s"] = steps / max(chunk_s, 1e-9)
     rec["wall_s"] = wall_s
