@@ -96,10 +96,11 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
                     f"non-finite loss or parameters after iteration {iteration + cfg.eval_every}; "
                     f"stopped, the last good checkpoint (iteration {iteration}) is kept in {cfg.run_dir}"
                 )
-            state, iteration, chunks_done = new_state, iteration + cfg.eval_every, chunks_done + 1
-            rec = _record(trainer, metrics, wall_before + time.perf_counter() - start, chunk_s, iteration)
-            with open(metrics_path, "a") as fh:
+            done = iteration + cfg.eval_every
+            rec = _record(trainer, metrics, wall_before + time.perf_counter() - start, chunk_s, done)
+            with open(metrics_path, "a") as fh:  # a line past the checkpoint is dropped on resume
                 fh.write(json.dumps(rec) + "\n")
+            state, iteration, chunks_done = new_state, done, chunks_done + 1
             progress.show(progress.line(rec, cfg.iterations), quiet)
             if iteration == cfg.iterations or (cfg.checkpoint_every and chunks_done % cfg.checkpoint_every == 0):
                 save(state, iteration)

@@ -115,7 +115,8 @@ def test_ctrl_c_saves_and_exits_cleanly(tmp_path):
     assert proc.returncode == 130
     step = checkpoint.latest_step(run_dir)
     assert "interrupted: saved iteration" in out and f"iteration {step} " in out
-    assert stable(run_dir)[-1]["iteration"] == step
+    # the checkpoint holds the last finished chunk; metrics may be one chunk ahead, dropped on resume
+    assert step >= 5 and step <= stable(run_dir)[-1]["iteration"] <= step + 5
 
 
 @pytest.mark.slow
