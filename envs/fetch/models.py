@@ -8,9 +8,10 @@ actuator (kp = m w^2, w = 50 rad/s) with joint damping 2 m w (critical), so it f
 like the reference's mocap weld (solref 0.02 1) follows the mocap body. The joint damping is
 integrated implicitly by the Euler integrator, so the drive stays stable at 10 ms timesteps; the z
 actuator carries a constant bias ``m g`` (gravity compensation, as the reference arm is held by its
-weld). Fingers: for Reach/Push/Slide (gripper blocked) they are one fixed closed block; for
-PickAndPlace two slide joints with position actuators (kp 30000, control 0..0.2, joint range
-0..0.05, as the reference) and friction-1, condim-4 contacts with the object.
+weld). Fingers: for Reach/Push/Slide (gripper blocked) they are one fixed closed block (Slide:
+four round tips at its corners, see below); for PickAndPlace two slide joints with position
+actuators (kp 30000, control 0..0.2, joint range 0..0.05, as the reference) and friction-1, condim-4
+contacts with the object.
 
 Why slide joints, not the reference's mocap weld: measured on this 2-core CPU (shared, so
 figures are rough) on the Push model at 10 x 4 ms, the slide-joint drive ran 7,200 control
@@ -20,13 +21,32 @@ target moved 5 cm ahead at every control step alike: the grip advances 3.0 cm in
 then 3.4 cm per step (weld: 3.2 cm), and stops within 0.2 mm of the target once it is held, so
 neither reaches the full 5 cm within one step, the reference's weld (same time constant) neither.
 
-Contact pairs: object-table (box-box), object-floor (plane-box), finger(s)-object (box-box). The
-gripper has no pair with the table: its z target is clipped so that the fingertips stay at or above
-the table top instead (see ``Layout.workspace``).
+Contact pairs: object-table (box-box), object-floor (plane-box), finger(s)-object (box-box); Slide's
+are below. The gripper has no pair with the table: its z target is clipped so that the fingertips
+stay at or above the table top instead (see ``Layout.workspace``).
 
-Slide: MJX cannot collide a cylinder with a box, so the puck is a box of half-size
-0.025 x 0.025 x 0.02 (the reference cylinder's radius and half-height), mass 2, with the
-reference's low friction (0.1, 0.005, 0.0001) on the puck-table pair.
+Slide. The puck is the reference's cylinder (radius 0.025, half-height 0.02, mass 2) with the
+reference's low friction (0.1, 0.005, 0.0001) on the puck-table pair. MJX 3.17 collides a cylinder
+with a plane, a sphere, a capsule or a cylinder, not with a box, so:
+
+- the table top is a plane at z = 0.4 (drawn over a non-colliding table box). A plane is infinite:
+  the puck cannot fall off the table's edges (x 0.695..1.945, y 0.3..1.2) as the reference's does;
+  it glides on at table height instead. Goals lie at most 1.713 + 0.05 in x, so a puck past the edge
+  fails in both; there is no object-floor pair (the puck cannot reach the floor).
+- the closed fingers strike it with four round corner tips (spheres of radius 0.004 at the grip
+  site's height, at (+-0.0155, +-0.0155) from it, the corner ``scripted.slide`` aims with); the
+  finger block is drawn only. A round tip pushes along the line from its centre to the puck's axis,
+  as the reference's box-finger corner does; the tip-puck pair has the reference finger-puck pair's
+  friction (1, torsional 0.05, condim 4).
+- the gripper weighs 13 kg (``SLIDE_GRIPPER_MASS``; drive gains scale with it, so its free motion is
+  unchanged): the reference arm's effective mass at the grip site along x and y (13.3 and 12.3 kg,
+  from its mass matrix at the Slide start). With the 4 kg of the other tasks a struck puck left
+  slower and stopped short (MuJoCo C replica, ``experiments/parity/slide_c.py``, 200 episodes:
+  23.5 % of them more than 5 cm short and 76.5 % success, against 2.5 % and 97.5 % at 13 kg).
+
+The earlier Slide model (a box puck of the same size on the box table, struck by the box finger
+block) tipped and spun the puck and launched it off the aimed line: 62.5 % any-step success against
+the reference's 96.5 % (see ``experiments/parity/README.md``).
 """
 
 from __future__ import annotations
@@ -45,6 +65,12 @@ GRIPPER_MASS = 4.0  # palm + fingers, the mass the xyz drive moves
 DRIVE_OMEGA = 50.0  # rad/s: the reference weld's time constant 0.02 s
 FINGER_KP = 30000.0
 FINGER_MASS = 1.0
+# Slide only (see the module docstring): the reference arm's effective mass at the grip site, the
+# fingertip corners that strike the puck, and their contact with it.
+SLIDE_GRIPPER_MASS = 13.0
+SLIDE_TIP_XY = 0.0155  # fingertip corner centres at (+-, +-) this from the grip site: scripted.FINGER_HALF_XY
+SLIDE_TIP_RADIUS = 0.004
+SLIDE_TIP_FRICTION = "1 1 0.05 0.01 0.01"  # the reference finger-puck pair: friction 1, torsional 0.05, condim 4
 
 # kind -> (table centre xyz, table half-size xyz, initial grip-site position). The start positions
 # are those the reference's episodes begin from (read off its resets in experiments/parity): Push
@@ -86,18 +112,26 @@ def mjcf(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations:
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
     (tx, ty, tz), (hx, hy, hz), (gx, gy, gz) = _SCENES[kind]
-    w = DRIVE_OMEGA
-    kp, kv = GRIPPER_MASS * w * w, 2.0 * GRIPPER_MASS * w
     has_object = kind != "reach"
     free_fingers = kind == "pick_and_place"
     slide = kind == "slide"
+    mass = SLIDE_GRIPPER_MASS if slide else GRIPPER_MASS
+    w = DRIVE_OMEGA
+    kp, kv = mass * w * w, 2.0 * mass * w
     obj_half = (OBJECT_HALF, OBJECT_HALF, PUCK_HALF_HEIGHT if slide else OBJECT_HALF)
     rest_z = TABLE_TOP + obj_half[2]
     ox, oy = gx + 0.1, gy + 0.1  # any spot on the table; reset moves it
     finger_z = 0.03 - FINGER_BELOW_SITE  # finger box half-height 0.03, bottom at -FINGER_BELOW_SITE
-    palm_mass = GRIPPER_MASS - (2 * FINGER_MASS if free_fingers else 0.0)
+    palm_mass = mass - (2 * FINGER_MASS if free_fingers else 0.0)
     friction = "0.1 0.1 0.005 0.0001 0.0001" if slide else "1 1 0.005 0.0001 0.0001"
     nograv = 'contype="0" conaffinity="0"'
+    table = f"""<geom name="table" type="box" pos="{_fmt(tx, ty, tz)}" size="{_fmt(hx, hy, hz)}" {nograv}
+          rgba="0.6 0.5 0.4 1"/>"""
+    if slide:  # the top face as a plane (MJX collides a cylinder with a plane, not with a box)
+        table = f"""<geom name="table" type="plane" pos="{_fmt(tx, ty, TABLE_TOP)}" size="{_fmt(hx, hy)} 0.1" {nograv}
+          rgba="0.6 0.5 0.4 1"/>
+    <geom name="table_body" type="box" pos="{_fmt(tx, ty, tz)}" size="{_fmt(hx, hy, hz - 0.001)}" {nograv}
+          rgba="0.6 0.5 0.4 1"/>"""
 
     if free_fingers:
         fdamp = 2.0 * FINGER_MASS * np.sqrt(FINGER_KP / FINGER_MASS)
@@ -118,6 +152,24 @@ def mjcf(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations:
         finger_pairs = """
     <pair geom1="finger_l" geom2="object" condim="4" friction="1 1 0.005 0.0001 0.0001"/>
     <pair geom1="finger_r" geom2="object" condim="4" friction="1 1 0.005 0.0001 0.0001"/>"""
+    elif slide:
+        # Closed fingers drawn as a block; they strike the puck with four round corner tips.
+        c, r = SLIDE_TIP_XY, SLIDE_TIP_RADIUS
+        tips = [(f"tip_{i}", sx * c, sy * c) for i, (sx, sy) in enumerate([(1, 1), (1, -1), (-1, 1), (-1, -1)])]
+        fingers = f"""
+      <geom name="fingers" type="box" size="{_fmt(c, c)} 0.03" pos="0 0 {finger_z + r:.6g}" mass="0.001"
+            {nograv} rgba="0.3 0.3 0.3 1"/>""" + "".join(
+            f"""
+      <geom name="{n}" type="sphere" size="{r:.6g}" pos="{_fmt(x, y)} 0" mass="0.001" {nograv}
+            rgba="0.3 0.3 0.3 1"/>"""
+            for n, x, y in tips
+        )
+        finger_act = ""
+        finger_pairs = "".join(
+            f"""
+    <pair geom1="{n}" geom2="object" condim="4" friction="{SLIDE_TIP_FRICTION}"/>"""
+            for n, _, _ in tips
+        )
     else:
         fingers = f"""
       <geom name="fingers" type="box" size="0.01 0.012 0.03" pos="0 0 {finger_z:.6g}" mass="0.001"
@@ -133,14 +185,18 @@ def mjcf(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations:
     obj = ""
     obj_pairs = ""
     if has_object:
+        size = _fmt(OBJECT_HALF, PUCK_HALF_HEIGHT) if slide else _fmt(*obj_half)
+        shape = f'type="{"cylinder" if slide else "box"}" size="{size}"'
         obj = f"""
     <body name="object" pos="{_fmt(ox, oy, rest_z)}">
       <freejoint name="object"/>
-      <geom name="object" type="box" size="{_fmt(*obj_half)}" mass="2" {nograv} rgba="0.9 0.2 0.2 1"/>
+      <geom name="object" {shape} mass="2" {nograv} rgba="0.9 0.2 0.2 1"/>
       <site name="object" pos="0 0 0" size="0.005"/>
     </body>"""
         obj_pairs = f"""
-    <pair geom1="object" geom2="table" condim="3" friction="{friction}"/>
+    <pair geom1="object" geom2="table" condim="3" friction="{friction}"/>"""
+        if not slide:  # the Slide table top is a plane: the puck cannot fall to the floor
+            obj_pairs += """
     <pair geom1="object" geom2="floor" condim="3"/>"""
 
     return f"""<mujoco model="fetch_{kind}">
@@ -149,8 +205,7 @@ def mjcf(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations:
           ls_iterations="{ls_iterations}" cone="pyramidal"/>
   <worldbody>
     <geom name="floor" type="plane" size="3 3 0.1" {nograv} rgba="0.8 0.8 0.8 1"/>
-    <geom name="table" type="box" pos="{_fmt(tx, ty, tz)}" size="{_fmt(hx, hy, hz)}" {nograv}
-          rgba="0.6 0.5 0.4 1"/>
+    {table}
     <body name="gripper" pos="{_fmt(gx, gy, gz)}">
       <joint name="grip_x" type="slide" axis="1 0 0" damping="{kv:.6g}"/>
       <joint name="grip_y" type="slide" axis="0 1 0" damping="{kv:.6g}"/>
@@ -166,7 +221,7 @@ def mjcf(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations:
     <general name="grip_x" joint="grip_x" gainprm="{kp:.6g}" biastype="affine" biasprm="0 {-kp:.6g} 0"/>
     <general name="grip_y" joint="grip_y" gainprm="{kp:.6g}" biastype="affine" biasprm="0 {-kp:.6g} 0"/>
     <general name="grip_z" joint="grip_z" gainprm="{kp:.6g}" biastype="affine"
-             biasprm="{GRIPPER_MASS * 9.81:.6g} {-kp:.6g} 0"/>{finger_act}
+             biasprm="{mass * 9.81:.6g} {-kp:.6g} 0"/>{finger_act}
   </actuator>
 </mujoco>
 """

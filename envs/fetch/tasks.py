@@ -24,10 +24,12 @@ Measured on CPU on these models, per timing 20 x 2 / 10 x 4 / 4 x 10 ms:
   0.58; a centred push, a = (0.6, 0, 0) for 6 steps, moves the cube 10.0 / 10.4 / 13.0 cm.
 - ``envs.fetch.scripted.push``, 100 episodes, final success: MuJoCo C 1.00 / 0.99 / 0.99, MJX
   1.00 / 1.00 / 0.97 (median final error 0.36-0.58 cm).
-- ``envs.fetch.scripted.slide``, 100 episodes, final success: MuJoCo C 0.28 / 0.37 / 0.56, MJX
-  0.50 / 0.46 / 0.60 with NaN in some episodes (MuJoCo C warned of instability too). A freely
-  sliding puck travels the same in both (0.5075 / 0.5076 m from 1 m/s), so the gap lies in the
-  pusher-puck impacts, whose box-box contacts MuJoCo C and MJX generate differently.
+- ``envs.fetch.scripted.slide`` on the earlier box-puck Slide model, 100 episodes, final success:
+  MuJoCo C 0.28 / 0.37 / 0.56, MJX 0.50 / 0.46 / 0.60 with NaN in some episodes (MuJoCo C warned
+  of instability too). A freely sliding puck travels the same in both (0.5075 / 0.5076 m from
+  1 m/s), so the gap lay in the pusher-puck impacts, whose box-box contacts MuJoCo C and MJX
+  generate differently. The cylinder-puck model (see models.py) reaches 0.965 in MJX at 10 x 4 ms
+  (200 episodes; ``experiments/parity``).
 - ``envs.fetch.scripted.pick_and_place``, 50 episodes, final success: MuJoCo C and MJX both
   1.00 / 1.00 / 0.00 (median error 0.21 cm): at 10 ms the finger drive (kp 30000) is unstable.
 
@@ -322,7 +324,8 @@ class Push(_FetchTask):
 
 @dataclasses.dataclass(frozen=True)
 class Slide(_FetchTask):
-    """Strike a low-friction puck (a flat box, see models.py) to a goal 0.4 m ahead, out of reach."""
+    """Strike a low-friction puck (a cylinder on a plane table top, see models.py) to a goal 0.4 m ahead,
+    out of reach."""
 
     obj_range: float = 0.1
     target_range: float = 0.3

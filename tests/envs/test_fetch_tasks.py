@@ -13,6 +13,7 @@ import functools
 import chex
 import jax
 import jax.numpy as jnp
+import mujoco
 import numpy as np
 import pytest
 
@@ -168,7 +169,22 @@ def test_model_has_only_listed_contact_pairs():
     for kind in models.KINDS:
         m = models.build(kind)[0]
         assert not m.geom_contype.any() and not m.geom_conaffinity.any()
-        assert m.npair == {"reach": 0, "push": 3, "slide": 3, "pick_and_place": 4}[kind]
+        assert m.npair == {"reach": 0, "push": 3, "slide": 5, "pick_and_place": 4}[kind]
+
+
+def test_slide_puck_is_a_cylinder_on_a_plane_struck_at_the_controller_corner():
+    m = models.build("slide")[0]
+    puck, table = m.geom("object"), m.geom("table")
+    assert puck.type[0] == mujoco.mjtGeom.mjGEOM_CYLINDER
+    np.testing.assert_allclose(puck.size[:2], [0.025, 0.02])
+    assert table.type[0] == mujoco.mjtGeom.mjGEOM_PLANE and table.pos[2] == models.TABLE_TOP
+    name = lambda i: m.geom(int(i)).name  # noqa: E731
+    pairs = {tuple(sorted((name(a), name(b)))) for a, b in zip(m.pair_geom1, m.pair_geom2, strict=True)}
+    assert ("floor", "object") not in pairs and ("object", "table") in pairs
+    # The controller aims the fingers' corner at the puck: the round tips sit there.
+    tips = [m.geom(f"tip_{i}") for i in range(4)]
+    corners = sorted((abs(float(t.pos[0])), abs(float(t.pos[1]))) for t in tips)
+    assert corners == [tuple(scripted.FINGER_HALF_XY)] * 4
 
 
 # ---- physics: one compiled program per task --------------------------------------------------------
@@ -225,9 +241,18 @@ def test_nan_action_is_flagged(name):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("name", "need"), [("reach", 1.0), ("push", 0.75), ("pick_and_place", 0.75), ("slide", 0.25)])
+@pytest.mark.parametrize(("name", "need"), [("reach", 1.0), ("push", 0.75), ("pick_and_place", 0.75), ("slide", 0.75)])
 def test_scripted_controllers_succeed_in_most_episodes(name, need):
     _, final, traj = _run(name, np.zeros((T, B, 4)), w=1.0)
     reached = np.asarray(traj.success).any(axis=0)
     assert reached.mean() >= need, reached
     assert not bool(traj.invalid.any())
+
+
+@pytest.mark.slow
+def test_struck_slide_puck_stays_flat_on_the_table():
+    s0, _, traj = _run("slide", np.zeros((T, B, 4)), w=1.0)  # the scripted slide's program and episodes
+    obs = np.asarray(traj.obs)
+    assert np.abs(obs[..., 3:6] - np.asarray(s0.obs)[None, :, 3:6]).max() > 0.1  # the pucks were struck
+    assert np.abs(obs[..., 11:13]).max() < 0.05  # roll and pitch: no tipping
+    assert np.abs(obs[..., 5] - _env("slide").layout.object_rest_z).max() < 2e-3  # no lift
