@@ -21,18 +21,25 @@ target moved 5 cm ahead at every control step alike: the grip advances 3.0 cm in
 then 3.4 cm per step (weld: 3.2 cm), and stops within 0.2 mm of the target once it is held, so
 neither reaches the full 5 cm within one step, the reference's weld (same time constant) neither.
 
-Contact pairs: object-table (box-box), object-floor (plane-box), finger(s)-object (box-box); Slide's
-are below. The gripper has no pair with the table: its z target is clipped so that the fingertips
-stay at or above the table top instead (see ``Layout.workspace``).
+Contact pairs: object-table (plane-box), finger(s)-object (box-box); Slide's are below. The gripper
+has no pair with the table: its z target is clipped so that the fingertips stay at or above the
+table top instead (see ``Layout.workspace``).
+
+Table. Its collision shape is its top face, a plane at z = 0.4, drawn over a non-colliding box
+(``table="box"`` gives the reference's box table and an object-floor pair instead). The plane-box
+contact is the cheaper one: one Push control step at batch 64 on the 2-core CPU took 16.5 ms
+against 22.4 ms with the box table (2026-11-23), and the scripted controllers succeed as often
+(200 episodes each, CPU MJX: Push and PickAndPlace 100 / 100 % with either table). A plane is
+infinite, so an object pushed past a table edge glides on at table height instead of falling;
+every goal lies on or above the table, so such an episode fails either way.
 
 Slide. The puck is the reference's cylinder (radius 0.025, half-height 0.02, mass 2) with the
 reference's low friction (0.1, 0.005, 0.0001) on the puck-table pair. MJX 3.17 collides a cylinder
 with a plane, a sphere, a capsule or a cylinder, not with a box, so:
 
-- the table top is a plane at z = 0.4 (drawn over a non-colliding table box). A plane is infinite:
-  the puck cannot fall off the table's edges (x 0.695..1.945, y 0.3..1.2) as the reference's does;
-  it glides on at table height instead. Goals lie at most 1.713 + 0.05 in x, so a puck past the edge
-  fails in both; there is no object-floor pair (the puck cannot reach the floor).
+- the table top is the plane (required: ``table="box"`` is refused for Slide). The puck cannot fall
+  off the table's edges (x 0.695..1.945, y 0.3..1.2) as the reference's does; goals lie at most
+  1.713 + 0.05 in x, so a puck past the edge fails in both.
 - the closed fingers strike it with four round corner tips (spheres of radius 0.004 at the grip
   site's height, at (+-0.0155, +-0.0155) from it, the corner ``scripted.slide`` aims with); the
   finger block is drawn only. A round tip pushes along the line from its centre to the puck's axis,
@@ -83,6 +90,7 @@ _SCENES = {
     "slide": ((1.32, 0.75, 0.2), (0.625, 0.45, 0.2), (1.013, 0.749, 0.416)),
 }
 KINDS = tuple(_SCENES)
+TABLES = ("plane", "box")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -107,10 +115,13 @@ def _fmt(*xs: float) -> str:
     return " ".join(f"{x:.6g}" for x in xs)
 
 
-def mjcf(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations: int = 4) -> str:
-    """The MJCF text of task ``kind`` (one of ``KINDS``)."""
+def mjcf(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations: int = 4, table: str = "plane") -> str:
+    """The MJCF text of task ``kind`` (one of ``KINDS``); ``table`` is the table's collision shape,
+    one of ``TABLES`` (Slide needs the plane)."""
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
+    if table not in TABLES or (kind == "slide" and table != "plane"):
+        raise ValueError(f"unknown table {table!r}: one of {TABLES} (slide: plane)")
     (tx, ty, tz), (hx, hy, hz), (gx, gy, gz) = _SCENES[kind]
     has_object = kind != "reach"
     free_fingers = kind == "pick_and_place"
@@ -125,9 +136,10 @@ def mjcf(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations:
     palm_mass = mass - (2 * FINGER_MASS if free_fingers else 0.0)
     friction = "0.1 0.1 0.005 0.0001 0.0001" if slide else "1 1 0.005 0.0001 0.0001"
     nograv = 'contype="0" conaffinity="0"'
+    plane_top = table == "plane"
     table = f"""<geom name="table" type="box" pos="{_fmt(tx, ty, tz)}" size="{_fmt(hx, hy, hz)}" {nograv}
           rgba="0.6 0.5 0.4 1"/>"""
-    if slide:  # the top face as a plane (MJX collides a cylinder with a plane, not with a box)
+    if plane_top:  # the top face as a plane: a cheaper contact than box-box, and MJX's only one for a cylinder
         table = f"""<geom name="table" type="plane" pos="{_fmt(tx, ty, TABLE_TOP)}" size="{_fmt(hx, hy)} 0.1" {nograv}
           rgba="0.6 0.5 0.4 1"/>
     <geom name="table_body" type="box" pos="{_fmt(tx, ty, tz)}" size="{_fmt(hx, hy, hz - 0.001)}" {nograv}
@@ -195,7 +207,7 @@ def mjcf(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations:
     </body>"""
         obj_pairs = f"""
     <pair geom1="object" geom2="table" condim="3" friction="{friction}"/>"""
-        if not slide:  # the Slide table top is a plane: the puck cannot fall to the floor
+        if not plane_top:  # on an infinite plane top the object cannot fall to the floor
             obj_pairs += """
     <pair geom1="object" geom2="floor" condim="3"/>"""
 
@@ -236,12 +248,12 @@ def _rest_height(m: mujoco.MjModel, object_q: int) -> float:
 
 
 @functools.cache
-def build(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations: int = 4):
+def build(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations: int = 4, table: str = "plane"):
     """``(mj_model, mjx_model, layout)`` for task ``kind``; cached, so tasks stay hashable."""
     import jax
     from mujoco import mjx
 
-    m = mujoco.MjModel.from_xml_string(mjcf(kind, timestep, iterations, ls_iterations))
+    m = mujoco.MjModel.from_xml_string(mjcf(kind, timestep, iterations, ls_iterations, table))
     jnt = lambda name: m.joint(name)  # noqa: E731
     grip_q = int(jnt("grip_x").qposadr[0])
     free_fingers = kind == "pick_and_place"

@@ -101,6 +101,7 @@ class _FetchTask(GoalEnv):
     substeps: int = 10
     iterations: int = 4
     ls_iterations: int = 4
+    table: str = "plane"  # the table's collision shape: its top face as a plane, or the reference's box
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -119,6 +120,8 @@ class _FetchTask(GoalEnv):
                 self.obj_range,
                 f"in [{MIN_OBJECT_DISTANCE}, 0.5] (the object starts >= {MIN_OBJECT_DISTANCE} m from the gripper)",
             )
+        tables = ("plane",) if n == "slide" else models.TABLES
+        check(self.table in tables, f"{n}.table", self.table, "one of " + ", ".join(tables))
         check(
             isinstance(self.max_episode_steps, int) and self.max_episode_steps >= 1,
             f"{n}.max_episode_steps",
@@ -155,7 +158,9 @@ class _FetchTask(GoalEnv):
     # ---- model -------------------------------------------------------------------------------
     @property
     def built(self):
-        return models.build(self.kind, float(self.timestep), int(self.iterations), int(self.ls_iterations))
+        return models.build(
+            self.kind, float(self.timestep), int(self.iterations), int(self.ls_iterations), str(self.table)
+        )
 
     @property
     def mj_model(self):

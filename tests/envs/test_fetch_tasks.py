@@ -136,6 +136,8 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("push", "distance_threshold", 0.0),
         ("push", "obj_range", -0.1),
         ("push", "obj_range", 0.05),  # no room for the 0.1 m minimum distance
+        ("push", "table", "mesh"),
+        ("slide", "table", "box"),  # MJX collides the cylinder puck with a plane only
         ("slide", "target_range", -0.3),
         ("pick_and_place", "substeps", 0),
         ("reach", "timestep", 0.0),
@@ -165,11 +167,26 @@ def test_euler_angles_match_the_rotation():
     np.testing.assert_allclose(tasks.quat_to_euler(q), [a, b, c], atol=1e-5)
 
 
+def _pairs(m: mujoco.MjModel) -> set[tuple[str, str]]:
+    name = lambda i: m.geom(int(i)).name  # noqa: E731
+    return {tuple(sorted((name(a), name(b)))) for a, b in zip(m.pair_geom1, m.pair_geom2, strict=True)}
+
+
 def test_model_has_only_listed_contact_pairs():
     for kind in models.KINDS:
         m = models.build(kind)[0]
         assert not m.geom_contype.any() and not m.geom_conaffinity.any()
-        assert m.npair == {"reach": 0, "push": 3, "slide": 5, "pick_and_place": 4}[kind]
+        assert m.npair == {"reach": 0, "push": 2, "slide": 5, "pick_and_place": 3}[kind]
+
+
+@pytest.mark.parametrize("kind", ["push", "pick_and_place"])
+def test_table_top_is_a_plane_by_default_and_the_box_table_adds_the_floor(kind):
+    plane, box = models.build(kind)[0], models.build(kind, table="box")[0]
+    assert plane.geom("table").type[0] == mujoco.mjtGeom.mjGEOM_PLANE and plane.geom("table").pos[2] == models.TABLE_TOP
+    assert box.geom("table").type[0] == mujoco.mjtGeom.mjGEOM_BOX
+    assert _pairs(box) - _pairs(plane) == {("floor", "object")}
+    # the object rests at the same height on either table
+    assert abs(models.build(kind)[2].object_rest_z - models.build(kind, table="box")[2].object_rest_z) < 1e-3
 
 
 def test_slide_puck_is_a_cylinder_on_a_plane_struck_at_the_controller_corner():
@@ -178,8 +195,7 @@ def test_slide_puck_is_a_cylinder_on_a_plane_struck_at_the_controller_corner():
     assert puck.type[0] == mujoco.mjtGeom.mjGEOM_CYLINDER
     np.testing.assert_allclose(puck.size[:2], [0.025, 0.02])
     assert table.type[0] == mujoco.mjtGeom.mjGEOM_PLANE and table.pos[2] == models.TABLE_TOP
-    name = lambda i: m.geom(int(i)).name  # noqa: E731
-    pairs = {tuple(sorted((name(a), name(b)))) for a, b in zip(m.pair_geom1, m.pair_geom2, strict=True)}
+    pairs = _pairs(m)
     assert ("floor", "object") not in pairs and ("object", "table") in pairs
     # The controller aims the fingers' corner at the puck: the round tips sit there.
     tips = [m.geom(f"tip_{i}") for i in range(4)]
