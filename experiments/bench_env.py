@@ -55,10 +55,14 @@ def parse_variant(text: str) -> tuple[str, dict]:
         key, sep, value = part.partition("=")
         if not sep:
             raise argparse.ArgumentTypeError(f"variant {text!r}: expected key=value[,key=value...]")
-        try:
-            overrides[key.strip()] = int(value) if value.strip().lstrip("-").isdigit() else float(value)
-        except ValueError as e:
-            raise argparse.ArgumentTypeError(f"variant {text!r}: {value!r} is not a number") from e
+        value = value.strip()
+        if value.lstrip("-").isdigit():
+            overrides[key.strip()] = int(value)
+        else:
+            try:
+                overrides[key.strip()] = float(value)
+            except ValueError:
+                overrides[key.strip()] = value  # a word, e.g. table=box
     return text, overrides
 
 

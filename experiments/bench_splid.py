@@ -3,6 +3,8 @@ by a replay) and replays per second, chunk time, compile
 time, and the cost of vmapping seeds, each against a peer measured in the same run.
 
     python experiments/bench_splid.py --env push --num-envs 64,256,1024 --seeds 8 --out bench.json
+    python experiments/bench_splid.py --env push --num-envs 1024,4096 --skip-chunk --train-iterations 10 \
+        --budgets 0.35,1 --out select.json
 
 Peers: SELECT on this machine's CPU cores through the same JAX code (``--cpu-peer``), and one seed
 for the vmapped-seeds ratio. Medians over ``--repeats`` timed calls after one warm-up call; compile
@@ -39,13 +41,27 @@ def timed(fn, *args, repeats: int):
     return {"median_s": med, "compile_s": max(first - med, 0.0), "runs": len(times)}
 
 
-def bench_select(env, cfg: TrainConfig, device, repeats: int) -> dict:
-    """Time SELECT alone on one explored batch; verdicts = candidates with t + h <= T."""
+def trained_policy(env, cfg: TrainConfig, iterations: int):
+    """The policy after ``iterations`` SPLID iterations: its exploration moves the object, so SELECT
+    sees the share of valid candidates it sees in training (an untrained policy rarely moves it)."""
+    trainer = Trainer(env, cfg)
+    state, hyper = trainer.init(jax.random.PRNGKey(0)), trainer.hyper()
+    for _ in range(iterations // cfg.eval_every):
+        state, metrics = trainer.chunk(state, hyper)
+    print(f"policy trained {iterations} iterations at N={cfg.num_envs}: eval success {metrics['eval_success']:.3f}")
+    return state.policy
+
+
+def bench_select(env, cfg: TrainConfig, device, repeats: int, pstate=None) -> dict:
+    """Time SELECT alone on one batch explored by ``pstate`` (default: an untrained policy);
+    verdicts = valid candidates decided by a replay."""
     trainer = Trainer(env, cfg)
     with jax.default_device(device):
-        state = trainer.init(jax.random.PRNGKey(0))
+        if pstate is None:
+            pstate = trainer.init(jax.random.PRNGKey(0)).policy
+        pstate = jax.device_put(pstate, device)
         traj = jax.jit(lambda ps, k: explore(env, trainer.policy, ps, k, cfg.num_envs, jnp.float32(cfg.sigma)))(
-            state.policy, jax.random.PRNGKey(1)
+            pstate, jax.random.PRNGKey(1)
         )
         fn = jax.jit(
             lambda ps, tr: select(
@@ -60,8 +76,8 @@ def bench_select(env, cfg: TrainConfig, device, repeats: int) -> dict:
                 cfg.select_budget,
             )
         )
-        out = timed(fn, state.policy, traj, repeats=repeats)
-        cands = fn(state.policy, traj)
+        out = timed(fn, pstate, traj, repeats=repeats)
+        cands = fn(pstate, traj)
     T, H, N = env.episode_length, cfg.horizon, cfg.num_envs
     slots = replay_slots(T, N, cfg.select_budget) * H  # candidates replayed, valid or filler
     verdicts = int(cands.valid.sum()) - int(cands.dropped)  # valid candidates decided by a replay
@@ -106,6 +122,11 @@ def main() -> None:
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--cpu-peer", type=int, default=0, help="num_envs for the SELECT peer on the CPU (0: skip)")
     p.add_argument("--skip-chunk", action="store_true")
+    p.add_argument("--budgets", default=None, help="SELECT replay budgets to time, e.g. 0.35,1 (default: the task's)")
+    p.add_argument(
+        "--train-iterations", type=int, default=0, help="train this many iterations first; SELECT uses that policy"
+    )
+    p.add_argument("--train-num-envs", type=int, default=512, help="num_envs of that training")
     p.add_argument("--out", default=None)
     a = p.parse_args()
     env = make_env(a.env)
@@ -120,16 +141,22 @@ def main() -> None:
         "select": [],
         "chunk": [],
     }
+    pstate = None
+    if a.train_iterations:
+        pstate = trained_policy(env, dataclasses.replace(base, num_envs=a.train_num_envs), a.train_iterations)
+        res["policy_trained_iterations"] = a.train_iterations
+    budgets = [float(b) for b in a.budgets.split(",")] if a.budgets else [base.select_budget]
     for n in [int(x) for x in a.num_envs.split(",")]:
         cfg = dataclasses.replace(base, num_envs=n)
-        r = bench_select(env, cfg, dev, a.repeats)
-        res["select"].append(r)
-        print(
-            f"SELECT {dev.platform} N={n}: {r['verdicts_per_s']:,.0f} verdicts/s ({r['verdicts']} valid decided), "
-            f"{r['replays_per_s']:,.0f} replays/s, "
-            f"{r['replay_steps_per_s']:,.0f} replay steps/s, {r['median_s']:.3f}s, compile {r['compile_s']:.1f}s",
-            flush=True,
-        )
+        for budget in budgets:
+            r = bench_select(env, dataclasses.replace(cfg, select_budget=budget), dev, a.repeats, pstate)
+            res["select"].append(r)
+            print(
+                f"SELECT {dev.platform} N={n} budget {budget}: {r['verdicts_per_s']:,.0f} verdicts/s "
+                f"({r['verdicts']} of {r['valid']} valid decided), {r['replays_per_s']:,.0f} replays/s, "
+                f"{r['replay_steps_per_s']:,.0f} replay steps/s, {r['median_s']:.3f}s, compile {r['compile_s']:.1f}s",
+                flush=True,
+            )
         if not a.skip_chunk:
             c = bench_chunk(env, cfg, a.seeds, a.repeats)
             res["chunk"].append(c)
@@ -140,7 +167,7 @@ def main() -> None:
             )
     if a.cpu_peer:
         cpu = jax.devices("cpu")[0]
-        r = bench_select(env, dataclasses.replace(base, num_envs=a.cpu_peer), cpu, max(1, a.repeats // 2))
+        r = bench_select(env, dataclasses.replace(base, num_envs=a.cpu_peer), cpu, max(1, a.repeats // 2), pstate)
         res["select_cpu_peer"] = r
         print(f"SELECT cpu peer N={a.cpu_peer}: {r['verdicts_per_s']:,.0f} verdicts/s", flush=True)
     if a.out:

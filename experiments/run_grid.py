@@ -1,0 +1,80 @@
+"""Several ``splid_jax.train`` runs at once on one device, then a table of what each reached.
+
+    python experiments/run_grid.py --out runs/grid --common "--env push --iterations 80 --num-envs 64" \
+        --run base= --run buf100k="--buffer-size 100000" --run bc1000="--bc-steps 1000"
+
+For screening settings by exploration episodes: concurrent runs share the device, so their
+wall-clock figures are not a speed measurement (rerun the winner alone for that). Each run writes
+``OUT/NAME/metrics.jsonl``; ``--summary-only`` just prints the table of existing run dirs."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shlex
+import subprocess
+import sys
+import time
+
+
+def first_reaching(records: list[dict], level: float) -> dict | None:
+    return next((r for r in records if r["eval_success"] >= level), None)
+
+
+def summary(run_dirs: list[str]) -> str:
+    rows = [
+        "| run | episodes to 0.8 | episodes to 0.9 | wall s to 0.9 | best (episodes) | last (final step) | episodes |",
+        "|---|---:|---:|---:|---|---|---:|",
+    ]
+    for d in run_dirs:
+        path = os.path.join(d, "metrics.jsonl")
+        recs = [json.loads(line) for line in open(path) if line.strip()] if os.path.exists(path) else []
+        if not recs:
+            rows.append(f"| {os.path.basename(d)} | - | - | - | - | - | 0 |")
+            continue
+        r8, r9 = first_reaching(recs, 0.8), first_reaching(recs, 0.9)
+        best = max(recs, key=lambda r: r["eval_success"])
+        last = recs[-1]
+        wall9 = f"{r9['wall_s']:.0f}" if r9 else "-"
+        rows.append(
+            f"| {os.path.basename(d)} | {r8['episodes'] if r8 else '-'} | {r9['episodes'] if r9 else '-'} | "
+            f"{wall9} | {best['eval_success']:.3f} ({best['episodes']}) | "
+            f"{last['eval_success']:.3f} ({last['eval_success_final']:.3f}) | {last['episodes']} |"
+        )
+    return "\n".join(rows)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--out", required=True, help="parent directory of the run dirs")
+    p.add_argument("--common", default="", help="flags every run gets")
+    p.add_argument("--run", action="append", default=[], metavar="NAME=FLAGS", help="one run: its name and flags")
+    p.add_argument("--summary-only", action="store_true", help="print the table of the run dirs under --out")
+    args = p.parse_args(argv)
+    if args.summary_only:
+        names = sorted(n for n in os.listdir(args.out) if os.path.isdir(os.path.join(args.out, n)))
+        print(summary([os.path.join(args.out, n) for n in names]))
+        return 0
+    os.makedirs(args.out, exist_ok=True)
+    env = dict(os.environ, XLA_PYTHON_CLIENT_PREALLOCATE="false")
+    procs, dirs = [], []
+    for spec in args.run:
+        name, _, flags = spec.partition("=")
+        run_dir = os.path.join(args.out, name)
+        cmd = [sys.executable, "-m", "splid_jax.train", *shlex.split(args.common), *shlex.split(flags)]
+        cmd += ["--run-dir", run_dir, "--checkpoint-every", "0", "--quiet"]
+        log = open(os.path.join(args.out, f"{name}.log"), "w")
+        log.write(" ".join(cmd) + "\n")
+        log.flush()
+        procs.append((name, subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env), time.time()))
+        dirs.append(run_dir)
+    for name, proc, t0 in procs:
+        rc = proc.wait()
+        print(f"{name}: exit {rc} after {time.time() - t0:.0f} s", flush=True)
+    print(summary(dirs))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
