@@ -185,7 +185,22 @@ def main(argv=None) -> int:
 
     device = str(jax.devices()[0])
     print(f"device {device} ({backend}), jax {jax.__version__}, mujoco {mujoco.__version__}", flush=True)
+    meta = {
+        "device": device,
+        "backend": backend,
+        "jax": jax.__version__,
+        "mujoco": mujoco.__version__,
+        "host": platform.node(),
+        "steps": args.steps,
+        "repeats": args.repeats,
+    }
     rows = []
+
+    def save():  # after every row, so a run cut short by a time limit keeps what it measured
+        if args.out:
+            args.out.parent.mkdir(parents=True, exist_ok=True)
+            args.out.write_text(json.dumps({"meta": meta, "results": rows}, indent=1))
+
     for task in args.tasks:
         for label, overrides in variants:
             for batch in batches:
@@ -194,9 +209,11 @@ def main(argv=None) -> int:
                 except Exception as e:  # e.g. out of device memory at a large batch
                     rows.append({"task": task, "variant": label, "batch": batch, "error": f"{type(e).__name__}: {e}"})
                     print(f"{task} {label} batch {batch}: {rows[-1]['error'][:200]}", flush=True)
+                    save()
                     break
                 row["variant"] = label
                 rows.append(row)
+                save()
                 print(
                     f"{task} {label} batch {batch}: compile {row['compile_s']:.1f} s, "
                     f"{row['control_steps_per_s']:,.0f} control steps/s",
@@ -205,17 +222,6 @@ def main(argv=None) -> int:
     print()
     print(markdown(rows))
     if args.out:
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        meta = {
-            "device": device,
-            "backend": backend,
-            "jax": jax.__version__,
-            "mujoco": mujoco.__version__,
-            "host": platform.node(),
-            "steps": args.steps,
-            "repeats": args.repeats,
-        }
-        args.out.write_text(json.dumps({"meta": meta, "results": rows}, indent=1))
         print(f"\nwrote {args.out}")
     return 0
 

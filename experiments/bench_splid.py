@@ -141,6 +141,11 @@ def main() -> None:
         "select": [],
         "chunk": [],
     }
+    def save():  # after every measurement, so a run cut short by a time limit keeps what it measured
+        if a.out:
+            with open(a.out, "w") as fh:
+                json.dump(res, fh, indent=2)
+
     pstate = None
     if a.train_iterations:
         pstate = trained_policy(env, dataclasses.replace(base, num_envs=a.train_num_envs), a.train_iterations)
@@ -151,6 +156,7 @@ def main() -> None:
         for budget in budgets:
             r = bench_select(env, dataclasses.replace(cfg, select_budget=budget), dev, a.repeats, pstate)
             res["select"].append(r)
+            save()
             print(
                 f"SELECT {dev.platform} N={n} budget {budget}: {r['verdicts_per_s']:,.0f} verdicts/s "
                 f"({r['verdicts']} of {r['valid']} valid decided), {r['replays_per_s']:,.0f} replays/s, "
@@ -160,6 +166,7 @@ def main() -> None:
         if not a.skip_chunk:
             c = bench_chunk(env, cfg, a.seeds, a.repeats)
             res["chunk"].append(c)
+            save()
             print(
                 f"CHUNK N={n}: 1 seed {c['one_seed']['median_s']:.3f}s (compile {c['one_seed']['compile_s']:.1f}s), "
                 f"{a.seeds} seeds {c[f'{a.seeds}_seeds']['median_s']:.3f}s: ratio {c['ratio_many_over_one']:.2f}",
@@ -169,10 +176,8 @@ def main() -> None:
         cpu = jax.devices("cpu")[0]
         r = bench_select(env, dataclasses.replace(base, num_envs=a.cpu_peer), cpu, max(1, a.repeats // 2), pstate)
         res["select_cpu_peer"] = r
+        save()
         print(f"SELECT cpu peer N={a.cpu_peer}: {r['verdicts_per_s']:,.0f} verdicts/s", flush=True)
-    if a.out:
-        with open(a.out, "w") as fh:
-            json.dump(res, fh, indent=2)
 
 
 if __name__ == "__main__":
