@@ -93,6 +93,11 @@ KINDS = tuple(_SCENES)
 TABLES = ("plane", "box")
 
 
+def tables_for(kind: str) -> tuple[str, ...]:
+    """The table shapes task ``kind`` can use: MJX collides Slide's cylinder puck with a plane only."""
+    return ("plane",) if kind == "slide" else TABLES
+
+
 @dataclasses.dataclass(frozen=True)
 class Layout:
     """Where things live in ``qpos``/``qvel``/``ctrl``, as Python ints (static under jit)."""
@@ -120,8 +125,8 @@ def mjcf(kind: str, timestep: float = 0.002, iterations: int = 4, ls_iterations:
     one of ``TABLES`` (Slide needs the plane)."""
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
-    if table not in TABLES or (kind == "slide" and table != "plane"):
-        raise ValueError(f"unknown table {table!r}: one of {TABLES} (slide: plane)")
+    if table not in tables_for(kind):
+        raise ValueError(f"table {table!r} for {kind}: one of {tables_for(kind)}")
     (tx, ty, tz), (hx, hy, hz), (gx, gy, gz) = _SCENES[kind]
     has_object = kind != "reach"
     free_fingers = kind == "pick_and_place"

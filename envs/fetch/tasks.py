@@ -120,7 +120,7 @@ class _FetchTask(GoalEnv):
                 self.obj_range,
                 f"in [{MIN_OBJECT_DISTANCE}, 0.5] (the object starts >= {MIN_OBJECT_DISTANCE} m from the gripper)",
             )
-        tables = ("plane",) if n == "slide" else models.TABLES
+        tables = models.tables_for(n)
         check(self.table in tables, f"{n}.table", self.table, "one of " + ", ".join(tables))
         check(
             isinstance(self.max_episode_steps, int) and self.max_episode_steps >= 1,
