@@ -102,6 +102,7 @@ class _FetchTask(GoalEnv):
     iterations: int = 4
     ls_iterations: int = 4
     table: str = "plane"  # the table's collision shape: its top face as a plane, or the reference's box
+    finger: str = "box"  # the closed finger block's collision shape (Push: box or capsule, see models.py)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -122,6 +123,8 @@ class _FetchTask(GoalEnv):
             )
         tables = models.tables_for(n)
         check(self.table in tables, f"{n}.table", self.table, "one of " + ", ".join(tables))
+        fingers = models.fingers_for(n)
+        check(self.finger in fingers, f"{n}.finger", self.finger, "one of " + ", ".join(fingers))
         check(
             isinstance(self.max_episode_steps, int) and self.max_episode_steps >= 1,
             f"{n}.max_episode_steps",
@@ -159,7 +162,12 @@ class _FetchTask(GoalEnv):
     @property
     def built(self):
         return models.build(
-            self.kind, float(self.timestep), int(self.iterations), int(self.ls_iterations), str(self.table)
+            self.kind,
+            float(self.timestep),
+            int(self.iterations),
+            int(self.ls_iterations),
+            str(self.table),
+            str(self.finger),
         )
 
     @property

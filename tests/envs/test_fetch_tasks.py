@@ -138,6 +138,7 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("push", "obj_range", 0.05),  # no room for the 0.1 m minimum distance
         ("push", "table", "mesh"),
         ("slide", "table", "box"),  # MJX collides the cylinder puck with a plane only
+        ("pick_and_place", "finger", "capsule"),  # two gripping box fingers
         ("slide", "target_range", -0.3),
         ("pick_and_place", "substeps", 0),
         ("reach", "timestep", 0.0),
@@ -187,6 +188,16 @@ def test_table_top_is_a_plane_by_default_and_the_box_table_adds_the_floor(kind):
     assert _pairs(box) - _pairs(plane) == {("floor", "object")}
     # the object rests at the same height on either table
     assert abs(models.build(kind)[2].object_rest_z - models.build(kind, table="box")[2].object_rest_z) < 1e-3
+
+
+def test_push_capsule_finger_replaces_the_box_in_the_same_pair():
+    box, capsule = models.build("push")[0], models.build("push", finger="capsule")[0]
+    assert box.geom("fingers").type[0] == mujoco.mjtGeom.mjGEOM_BOX
+    assert capsule.geom("fingers").type[0] == mujoco.mjtGeom.mjGEOM_CAPSULE
+    assert _pairs(capsule) == _pairs(box) and ("fingers", "object") in _pairs(box)
+    # same centre and half-height (radius + half-length), so the fingertips reach as low as the block's
+    np.testing.assert_allclose(capsule.geom("fingers").pos, box.geom("fingers").pos)
+    np.testing.assert_allclose(capsule.geom("fingers").size[0] + capsule.geom("fingers").size[1], 0.03)
 
 
 def test_slide_puck_is_a_cylinder_on_a_plane_struck_at_the_controller_corner():
