@@ -17,6 +17,24 @@ _REGISTRY = {
 }
 
 
+def parse_overrides(text: str, field: str = "env_options") -> dict:
+    """``"finger=capsule,substeps=20"`` -> ``{"finger": "capsule", "substeps": 20}``: integers, floats
+    and words; an empty text is no override. A malformed item fails naming ``field``."""
+    overrides = {}
+    for part in filter(None, (p.strip() for p in text.split(","))):
+        key, sep, value = (x.strip() for x in part.partition("="))
+        if not sep or not key or not value:
+            raise InvalidConfig(field, text, "KEY=VALUE[,KEY=VALUE...] with task fields as keys")
+        try:
+            overrides[key] = int(value)
+        except ValueError:
+            try:
+                overrides[key] = float(value)
+            except ValueError:
+                overrides[key] = value
+    return overrides
+
+
 def names() -> list[str]:
     return list(_REGISTRY)
 
@@ -34,4 +52,4 @@ def make(name: str, **overrides) -> GoalEnv:
     return cls(**overrides)
 
 
-__all__ = ["GoalEnv", "InvalidConfig", "State", "make", "names"]
+__all__ = ["GoalEnv", "InvalidConfig", "State", "make", "names", "parse_overrides"]

@@ -50,20 +50,10 @@ def parse_variant(text: str) -> tuple[str, dict]:
     """``"default"`` or ``"substeps=20,timestep=0.002"`` -> (label, overrides)."""
     if text in ("", "default"):
         return "default", {}
-    overrides = {}
-    for part in text.split(","):
-        key, sep, value = part.partition("=")
-        if not sep:
-            raise argparse.ArgumentTypeError(f"variant {text!r}: expected key=value[,key=value...]")
-        value = value.strip()
-        if value.lstrip("-").isdigit():
-            overrides[key.strip()] = int(value)
-        else:
-            try:
-                overrides[key.strip()] = float(value)
-            except ValueError:
-                overrides[key.strip()] = value  # a word, e.g. table=box
-    return text, overrides
+    try:
+        return text, envs.parse_overrides(text, field="variant")
+    except envs.InvalidConfig as e:
+        raise argparse.ArgumentTypeError(str(e)) from e
 
 
 def make_program(env, steps: int):

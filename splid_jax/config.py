@@ -37,6 +37,9 @@ class TrainConfig:
     eval_episodes: int = _f(None, "episodes of the deterministic policy per evaluation")
     checkpoint_every: int = _f(1, "chunks between checkpoints (0: only at the end)")
     run_dir: str | None = _f(None, "directory for config.json, metrics.jsonl and checkpoints (default runs/ENV-sSEED)")
+    env_options: str = _f(
+        "", "task fields as KEY=VALUE[,KEY=VALUE...], e.g. finger=capsule or substeps=20,timestep=0.002"
+    )
 
     def __post_init__(self):
         check(self.env in envs.names(), "env", self.env, "one of " + ", ".join(envs.names()))
@@ -67,6 +70,10 @@ class TrainConfig:
         if self.run_dir is None:
             object.__setattr__(self, "run_dir", os.path.join("runs", f"{self.env}-s{self.seed}"))
         check(not os.path.isfile(self.run_dir), "run_dir", self.run_dir, "a directory, not an existing file")
+        self.env_overrides()  # the syntax; the fields themselves are checked where the task is built
+
+    def env_overrides(self) -> dict[str, Any]:
+        return envs.parse_overrides(self.env_options)
 
     def check_env(self, env: envs.GoalEnv) -> None:
         """Checks that need the task's sizes."""

@@ -27,7 +27,7 @@ def load_policy(run_dir: str):
         raise InvalidConfig("run_dir", run_dir, "a run directory holding config.json")
     with open(path) as fh:
         cfg = TrainConfig(**{**json.load(fh), "run_dir": run_dir})
-    env = make_env(cfg.env)
+    env = make_env(cfg.env, **cfg.env_overrides())
     trainer = Trainer(env, cfg)
     step, state, _ = checkpoint.restore(run_dir, trainer.init(jax.random.PRNGKey(0)))
     return env, trainer, state, step

@@ -45,7 +45,7 @@ def members(seeds: int, sigmas: tuple[float, ...], horizons: tuple[int, ...], ba
 
 def run_sweep(cfg: TrainConfig, grid: list[Member], quiet: bool = False) -> list[dict]:
     """Train every member of ``grid`` in lock-step; returns each member's last metrics record."""
-    env = make_env(cfg.env)
+    env = make_env(cfg.env, **cfg.env_overrides())
     max_h = max(m.horizon for m in grid)
     trainer = Trainer(env, dataclasses.replace(cfg, horizon=max_h))
     keys = jnp.stack([jax.random.PRNGKey(m.seed) for m in grid])
@@ -105,7 +105,7 @@ def main(argv: list[str] | None = None) -> int:
         horizons = tuple(int(x) for x in ns.horizons.split(","))
         grid = members(ns.seeds, sigmas, horizons, base_seed=given.get("seed", 0))
         cfg = TrainConfig(**{**given, "horizon": max(horizons), "sigma": max(sigmas)})
-        cfg.check_env(make_env(cfg.env))
+        cfg.check_env(make_env(cfg.env, **cfg.env_overrides()))
     except (InvalidConfig, ValueError) as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 2

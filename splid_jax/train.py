@@ -38,7 +38,10 @@ def make_env(name: str, **overrides) -> envs.GoalEnv:
 
 def _identity(cfg: TrainConfig) -> dict:
     """The settings a checkpoint must share with the run resuming it, as JSON stores them."""
-    return json.loads(json.dumps({k: v for k, v in cfg.to_json().items() if k not in _MAY_CHANGE_ON_RESUME}))
+    ident = {k: v for k, v in cfg.to_json().items() if k not in _MAY_CHANGE_ON_RESUME}
+    if not ident["env_options"]:  # absent from runs saved before the field existed; "" means the same
+        del ident["env_options"]
+    return json.loads(json.dumps(ident))
 
 
 def _record(trainer: Trainer, metrics: dict, wall_s: float, chunk_s: float, iteration: int) -> dict:
@@ -56,7 +59,7 @@ def _record(trainer: Trainer, metrics: dict, wall_s: float, chunk_s: float, iter
 def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False, quiet: bool = False) -> dict:
     """Train to ``cfg.iterations``; returns the last metrics record. Resumes from the newest
     checkpoint in ``cfg.run_dir`` when ``resume``."""
-    env = env or make_env(cfg.env)
+    env = env or make_env(cfg.env, **cfg.env_overrides())
     trainer = Trainer(env, cfg)
     os.makedirs(cfg.run_dir, exist_ok=True)
     metrics_path = os.path.join(cfg.run_dir, "metrics.jsonl")
@@ -164,7 +167,7 @@ def main(argv: list[str] | None = None) -> int:
     ns = parser.parse_args(argv)
     try:
         cfg, resume = config_from_cli(ns)
-        env = make_env(cfg.env)
+        env = make_env(cfg.env, **cfg.env_overrides())
         cfg.check_env(env)
         if resume and checkpoint.latest_step(cfg.run_dir) is None:
             raise InvalidConfig("resume", cfg.run_dir, "a run directory holding a checkpoint")

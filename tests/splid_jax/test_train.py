@@ -53,6 +53,9 @@ def final_params(run_dir):
         (["--num-envs", "0"], "num_envs"),
         (["--env", "nope"], "env"),
         (["--iterations", "7", "--eval-every", "5"], "iterations"),
+        (["--env-options", "success_radius"], "env_options"),
+        (["--env-options", "bogus=1"], "point.bogus"),
+        (["--env-options", "max_episode_steps=8"], "horizon"),  # H = 8 must stay below the episode length
     ],
 )
 def test_bad_values_stop_before_any_work(tmp_path, capsys, args, field):
@@ -151,3 +154,14 @@ def test_corrupt_and_mismatched_checkpoints_fail_clearly(tmp_path, capsys):
                     fh.truncate(os.path.getsize(path) // 2)
     assert main(["--resume", str(run_dir), "--iterations", "10", "--quiet"]) == 3
     assert "error" in capsys.readouterr().err
+
+
+def test_env_options_build_the_task_the_run_trains_on(tmp_path):
+    run_dir = tmp_path / "run"
+    args = ["--run-dir", str(run_dir), "--iterations", "5", "--num-envs", "4", "--bc-steps", "2"]
+    args += ["--eval-episodes", "4"]
+    assert main([*args, "--env-options", "max_episode_steps=20,success_radius=0.5", "--quiet"]) == 0
+    cfg = json.load(open(run_dir / "config.json"))
+    assert cfg["env_options"] == "max_episode_steps=20,success_radius=0.5"
+    rec = json.loads(open(run_dir / "metrics.jsonl").readline())
+    assert rec["env_steps"] == 5 * 4 * 20  # episodes of the overridden length
