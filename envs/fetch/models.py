@@ -277,19 +277,13 @@ def _rest_height(m: mujoco.MjModel, object_q: int) -> float:
 
 
 @functools.cache
-def build(
-    kind: str,
-    timestep: float = 0.002,
-    iterations: int = 4,
-    ls_iterations: int = 4,
-    table: str = "plane",
-    finger: str = "box",
-):
-    """``(mj_model, mjx_model, layout)`` for task ``kind``; cached, so tasks stay hashable."""
+def build(kind: str, **options):
+    """``(mj_model, mjx_model, layout)`` for task ``kind`` with ``mjcf``'s keyword ``options``; cached,
+    so tasks stay hashable."""
     import jax
     from mujoco import mjx
 
-    m = mujoco.MjModel.from_xml_string(mjcf(kind, timestep, iterations, ls_iterations, table, finger))
+    m = mujoco.MjModel.from_xml_string(mjcf(kind, **options))
     jnt = lambda name: m.joint(name)  # noqa: E731
     grip_q = int(jnt("grip_x").qposadr[0])
     free_fingers = kind == "pick_and_place"

@@ -163,11 +163,11 @@ class _FetchTask(GoalEnv):
     def built(self):
         return models.build(
             self.kind,
-            float(self.timestep),
-            int(self.iterations),
-            int(self.ls_iterations),
-            str(self.table),
-            str(self.finger),
+            timestep=float(self.timestep),
+            iterations=int(self.iterations),
+            ls_iterations=int(self.ls_iterations),
+            table=str(self.table),
+            finger=str(self.finger),
         )
 
     @property
