@@ -10,7 +10,9 @@ import dataclasses
 import io
 import json
 import os
+import signal
 import sys
+import threading
 import time
 
 import jax
@@ -86,7 +88,8 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
 
     def save(st, it):
         meta = {"config": _identity(cfg), "wall_s": wall_before + time.perf_counter() - start}
-        checkpoint.save(cfg.run_dir, it, st, meta)
+        with _interrupt_after():
+            checkpoint.save(cfg.run_dir, it, st, meta)
 
     try:
         while iteration < cfg.iterations:
@@ -108,7 +111,8 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
             if iteration == cfg.iterations or (cfg.checkpoint_every and chunks_done % cfg.checkpoint_every == 0):
                 save(state, iteration)
     except KeyboardInterrupt:
-        save(state, iteration)
+        if checkpoint.latest_step(cfg.run_dir) != iteration:
+            save(state, iteration)
         progress.show(f"interrupted: saved iteration {iteration} to {cfg.run_dir}; resume with --resume", quiet)
         raise
     except RunStopped:
@@ -116,6 +120,23 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
             save(state, iteration)
         raise
     return rec
+
+
+@contextlib.contextmanager
+def _interrupt_after():
+    """Holds a Ctrl-C that comes during the block until the block is done: an interrupted orbax save
+    leaves a temporary directory that the save on the way out cannot replace."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught = []
+    previous = signal.signal(signal.SIGINT, lambda *_: caught.append(True))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if caught:
+        raise KeyboardInterrupt
 
 
 def _read_jsonl(path: str) -> list[dict]:

@@ -14,7 +14,7 @@ import pytest
 
 from splid_jax import checkpoint
 from splid_jax.config import TrainConfig
-from splid_jax.train import RunStopped, main, run
+from splid_jax.train import RunStopped, _interrupt_after, main, run
 from splid_jax.trainer import Trainer
 
 TINY = ["--env", "point", "--num-envs", "8", "--eval-episodes", "16", "--bc-steps", "40", "--batch-size", "64",
@@ -165,3 +165,15 @@ def test_env_options_build_the_task_the_run_trains_on(tmp_path):
     assert cfg["env_options"] == "max_episode_steps=20,success_radius=0.5"
     rec = json.loads(open(run_dir / "metrics.jsonl").readline())
     assert rec["env_steps"] == 5 * 4 * 20  # episodes of the overridden length
+
+
+def test_ctrl_c_during_a_checkpoint_write_waits_for_the_write(tmp_path):
+    state = {"w": np.arange(4.0)}
+    with pytest.raises(KeyboardInterrupt):
+        with _interrupt_after():
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.05)  # the signal is handled in here, and held
+            checkpoint.save(str(tmp_path), 5, state, {"config": {}})
+    assert checkpoint.latest_step(str(tmp_path)) == 5  # written whole, then the interrupt came
+    _, restored, _ = checkpoint.restore(str(tmp_path), state)
+    np.testing.assert_array_equal(restored["w"], state["w"])
