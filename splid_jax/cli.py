@@ -16,9 +16,13 @@ def _int_tuple(text: str) -> tuple[int, ...]:
 _TYPES = {"int": int, "float": float, "str": str, "str | None": str, "tuple[int, ...]": _int_tuple}
 
 
-def add_config_flags(parser: argparse.ArgumentParser, cls, per_task: dict[str, dict] | None = None) -> None:
-    """One flag per field; every default is None so that explicit values can be told apart."""
+def add_config_flags(
+    parser: argparse.ArgumentParser, cls, per_task: dict[str, dict] | None = None, exclude: frozenset[str] = frozenset()
+) -> None:
+    """One flag per field (less ``exclude``); every default is None so that explicit values can be told apart."""
     for f in dataclasses.fields(cls):
+        if f.name in exclude:
+            continue
         flag = "--" + f.name.replace("_", "-")
         help_text = f.metadata.get("help", "")
         if f.default is not None:

@@ -91,7 +91,9 @@ def main(argv: list[str] | None = None) -> int:
         prog="python -m splid_jax.sweep",
         description="Run a grid of seeds x sigma x H as one vmapped, compiled program; one metrics file per member.",
     )
-    add_config_flags(parser, TrainConfig, TASK_DEFAULTS)
+    # --sigmas and --horizons replace the single values (--sigma and --horizon abbreviate them);
+    # a sweep keeps no checkpoints
+    add_config_flags(parser, TrainConfig, TASK_DEFAULTS, exclude=frozenset({"sigma", "horizon", "checkpoint_every"}))
     parser.add_argument("--seeds", type=int, default=4, help="seeds per grid point (default: 4)")
     parser.add_argument("--sigmas", default="1.0", help="comma-separated sigma values (default: 1.0)")
     parser.add_argument("--horizons", default="8", help="comma-separated H values (default: 8)")

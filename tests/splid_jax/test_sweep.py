@@ -2,6 +2,8 @@
 
 import json
 
+import pytest
+
 from splid_jax import sweep
 from splid_jax.config import TrainConfig
 
@@ -30,4 +32,11 @@ def test_grid_runs_as_one_program_with_a_file_per_member(tmp_path):
 def test_cli_rejects_a_bad_grid(capsys, tmp_path):
     assert sweep.main(["--env", "point", "--horizons", "0,4", "--run-dir", str(tmp_path / "x")]) == 2
     assert "horizons" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
+
+
+def test_cli_refuses_checkpoint_every_which_a_sweep_would_ignore(capsys, tmp_path):
+    with pytest.raises(SystemExit) as exc:
+        sweep.main(["--env", "point", "--checkpoint-every", "1", "--run-dir", str(tmp_path / "x")])
+    assert exc.value.code == 2 and "--checkpoint-every" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
