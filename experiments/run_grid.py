@@ -11,16 +11,21 @@ time; concurrent wall-clock figures are no speed measurement. Each run writes
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import shlex
 import subprocess
 import sys
 import time
 
+import numpy as np
 
-def first_reaching(records: list[dict], level: float) -> dict | None:
-    return next((r for r in records if r["eval_success"] >= level), None)
+from splid_jax import plot
+
+
+def _first(col: dict, level: float, key: str) -> str:
+    """``key`` at the first evaluation with success >= ``level``, or "-"."""
+    hit = np.flatnonzero(col["eval_success"] >= level)
+    return f"{col[key][hit[0]]:.0f}" if hit.size else "-"
 
 
 def summary(run_dirs: list[str]) -> str:
@@ -29,19 +34,16 @@ def summary(run_dirs: list[str]) -> str:
         "|---|---:|---:|---:|---|---|---:|",
     ]
     for d in run_dirs:
-        path = os.path.join(d, "metrics.jsonl")
-        recs = [json.loads(line) for line in open(path) if line.strip()] if os.path.exists(path) else []
-        if not recs:
+        try:
+            col = plot.load_run(d).columns  # tolerates a last line cut off by a stopped run
+        except plot.PlotError:
             rows.append(f"| {os.path.basename(d)} | - | - | - | - | - | 0 |")
             continue
-        r8, r9 = first_reaching(recs, 0.8), first_reaching(recs, 0.9)
-        best = max(recs, key=lambda r: r["eval_success"])
-        last = recs[-1]
-        wall9 = f"{r9['wall_s']:.0f}" if r9 else "-"
+        best = int(np.argmax(col["eval_success"]))
         rows.append(
-            f"| {os.path.basename(d)} | {r8['episodes'] if r8 else '-'} | {r9['episodes'] if r9 else '-'} | "
-            f"{wall9} | {best['eval_success']:.3f} ({best['episodes']}) | "
-            f"{last['eval_success']:.3f} ({last['eval_success_final']:.3f}) | {last['episodes']} |"
+            f"| {os.path.basename(d)} | {_first(col, 0.8, 'episodes')} | {_first(col, 0.9, 'episodes')} | "
+            f"{_first(col, 0.9, 'wall_s')} | {col['eval_success'][best]:.3f} ({col['episodes'][best]:.0f}) | "
+            f"{col['eval_success'][-1]:.3f} ({col['eval_success_final'][-1]:.3f}) | {col['episodes'][-1]:.0f} |"
         )
     return "\n".join(rows)
 
