@@ -46,9 +46,10 @@ def trained_policy(env, cfg: TrainConfig, iterations: int):
     sees the share of valid candidates it sees in training (an untrained policy rarely moves it)."""
     trainer = Trainer(env, cfg)
     state, hyper = trainer.init(jax.random.PRNGKey(0)), trainer.hyper()
-    for _ in range(iterations // cfg.eval_every):
+    for _ in range(-(-iterations // cfg.eval_every)):  # whole chunks, at least one
         state, metrics = trainer.chunk(state, hyper)
-    print(f"policy trained {iterations} iterations at N={cfg.num_envs}: eval success {metrics['eval_success']:.3f}")
+    done = int(state.iteration)
+    print(f"policy trained {done} iterations at N={cfg.num_envs}: eval success {metrics['eval_success']:.3f}")
     return state.policy
 
 
