@@ -1,10 +1,13 @@
-"""Speed of the SPLID iteration on one device: SELECT verdicts per second (valid candidates decided
-by a replay) and replays per second, chunk time, compile
+"""Speed of the SPLID iteration on one device: SELECT verdicts per second, chunk time, compile
 time, and the cost of vmapping seeds, each against a peer measured in the same run.
 
     python experiments/bench_splid.py --env push --num-envs 64,256,1024 --seeds 8 --out bench.json
     python experiments/bench_splid.py --env push --num-envs 1024,4096 --skip-chunk --train-iterations 10 \
-        --budgets 0.35,1 --out select.json
+        --lanes 0.25,0.5,1 --out select.json
+
+Two verdict counts: *replayed* verdicts are the valid candidates (the object moved toward g'), each
+decided by a replay; *pairs* are all (t, h) candidates with t + h <= T, the rest of which SELECT
+rejects without a replay (g' is already achieved at s_t: the policy ties at zero steps).
 
 Peers: SELECT on this machine's CPU cores through the same JAX code (``--cpu-peer``), and one seed
 for the vmapped-seeds ratio. Medians over ``--repeats`` timed calls after one warm-up call; compile
@@ -16,6 +19,7 @@ import argparse
 import dataclasses
 import json
 import statistics
+import sys
 import time
 
 import jax
@@ -23,7 +27,7 @@ import jax.numpy as jnp
 
 from splid_jax.config import TrainConfig
 from splid_jax.explore import explore
-from splid_jax.select import replay_slots, select
+from splid_jax.select import num_lanes, select
 from splid_jax.train import make_env
 from splid_jax.trainer import Trainer
 
@@ -54,8 +58,7 @@ def trained_policy(env, cfg: TrainConfig, iterations: int):
 
 
 def bench_select(env, cfg: TrainConfig, device, repeats: int, pstate=None) -> dict:
-    """Time SELECT alone on one batch explored by ``pstate`` (default: an untrained policy);
-    verdicts = valid candidates decided by a replay."""
+    """Time SELECT alone on one batch explored by ``pstate`` (default: an untrained policy)."""
     trainer = Trainer(env, cfg)
     with jax.default_device(device):
         if pstate is None:
@@ -73,24 +76,26 @@ def bench_select(env, cfg: TrainConfig, device, repeats: int, pstate=None) -> di
                 cfg.horizon,
                 jnp.int32(cfg.horizon),
                 True,
-                jax.random.PRNGKey(2),
-                cfg.select_budget,
+                cfg.select_lanes,
             )
         )
         out = timed(fn, pstate, traj, repeats=repeats)
         cands = fn(pstate, traj)
     T, H, N = env.episode_length, cfg.horizon, cfg.num_envs
-    slots = replay_slots(T, N, cfg.select_budget) * H  # candidates replayed, valid or filler
-    verdicts = int(cands.valid.sum()) - int(cands.dropped)  # valid candidates decided by a replay
+    pairs = N * sum(T - h + 1 for h in range(1, H + 1))  # (t, h) with t + h <= T
+    verdicts, steps = int(cands.valid.sum()), int(cands.replay_steps)
     out.update(
         device=str(device),
         num_envs=N,
-        select_budget=cfg.select_budget,
-        valid=int(cands.valid.sum()),
+        select_lanes=cfg.select_lanes,
+        lanes=num_lanes(T, N, cfg.select_lanes),
+        pairs=pairs,
         verdicts=verdicts,
+        replay_steps=steps,
+        pairs_per_s=pairs / out["median_s"],
         verdicts_per_s=verdicts / out["median_s"],
-        replays_per_s=slots / out["median_s"],
-        replay_steps_per_s=trainer.counters(1)["select_steps"] / out["median_s"],
+        replay_steps_per_s=steps / out["median_s"],
+        steps_per_verdict=steps / max(verdicts, 1),
     )
     return out
 
@@ -123,18 +128,28 @@ def main() -> None:
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--cpu-peer", type=int, default=0, help="num_envs for the SELECT peer on the CPU (0: skip)")
     p.add_argument("--skip-chunk", action="store_true")
-    p.add_argument("--budgets", default=None, help="SELECT replay budgets to time, e.g. 0.35,1 (default: the task's)")
+    p.add_argument("--lanes", default=None, help="SELECT lane fractions to time, e.g. 0.25,0.5,1 (default: the task's)")
+    p.add_argument("--env-options", default="", help="task fields as KEY=VALUE[,...], as in train")
     p.add_argument(
         "--train-iterations", type=int, default=0, help="train this many iterations first; SELECT uses that policy"
     )
     p.add_argument("--train-num-envs", type=int, default=512, help="num_envs of that training")
     p.add_argument("--out", default=None)
     a = p.parse_args()
-    env = make_env(a.env)
-    base = TrainConfig(env=a.env, horizon=a.horizon, eval_every=a.eval_every, iterations=a.eval_every, run_dir="/tmp/x")
+    base = TrainConfig(
+        env=a.env,
+        horizon=a.horizon,
+        eval_every=a.eval_every,
+        iterations=a.eval_every,
+        run_dir="/tmp/x",
+        env_options=a.env_options,
+    )
+    env = make_env(a.env, **base.env_overrides())
     dev = jax.devices()[0]
     res = {
         "env": a.env,
+        "env_options": a.env_options,
+        "command": " ".join(["python", *sys.argv]),
         "device": dev.device_kind,
         "platform": dev.platform,
         "jax": jax.__version__,
@@ -142,6 +157,7 @@ def main() -> None:
         "select": [],
         "chunk": [],
     }
+
     def save():  # after every measurement, so a run cut short by a time limit keeps what it measured
         if a.out:
             with open(a.out, "w") as fh:
@@ -151,19 +167,14 @@ def main() -> None:
     if a.train_iterations:
         pstate = trained_policy(env, dataclasses.replace(base, num_envs=a.train_num_envs), a.train_iterations)
         res["policy_trained_iterations"] = a.train_iterations
-    budgets = [float(b) for b in a.budgets.split(",")] if a.budgets else [base.select_budget]
+    lanes = [float(x) for x in a.lanes.split(",")] if a.lanes else [base.select_lanes]
     for n in [int(x) for x in a.num_envs.split(",")]:
         cfg = dataclasses.replace(base, num_envs=n)
-        for budget in budgets:
-            r = bench_select(env, dataclasses.replace(cfg, select_budget=budget), dev, a.repeats, pstate)
+        for frac in lanes:
+            r = bench_select(env, dataclasses.replace(cfg, select_lanes=frac), dev, a.repeats, pstate)
             res["select"].append(r)
             save()
-            print(
-                f"SELECT {dev.platform} N={n} budget {budget}: {r['verdicts_per_s']:,.0f} verdicts/s "
-                f"({r['verdicts']} of {r['valid']} valid decided), {r['replays_per_s']:,.0f} replays/s, "
-                f"{r['replay_steps_per_s']:,.0f} replay steps/s, {r['median_s']:.3f}s, compile {r['compile_s']:.1f}s",
-                flush=True,
-            )
+            print(f"SELECT {dev.platform} N={n} lanes {frac} ({r['lanes']}): {_select_line(r)}", flush=True)
         if not a.skip_chunk:
             c = bench_chunk(env, cfg, a.seeds, a.repeats)
             res["chunk"].append(c)
@@ -178,7 +189,15 @@ def main() -> None:
         r = bench_select(env, dataclasses.replace(base, num_envs=a.cpu_peer), cpu, max(1, a.repeats // 2), pstate)
         res["select_cpu_peer"] = r
         save()
-        print(f"SELECT cpu peer N={a.cpu_peer}: {r['verdicts_per_s']:,.0f} verdicts/s", flush=True)
+        print(f"SELECT cpu peer N={a.cpu_peer}: {_select_line(r)}", flush=True)
+
+
+def _select_line(r: dict) -> str:
+    return (
+        f"{r['verdicts_per_s']:,.0f} replayed verdicts/s ({r['verdicts']} valid), {r['pairs_per_s']:,.0f} pairs/s, "
+        f"{r['replay_steps_per_s']:,.0f} replay steps/s ({r['steps_per_verdict']:.2f} per verdict), "
+        f"{r['median_s']:.3f}s, compile {r['compile_s']:.1f}s"
+    )
 
 
 if __name__ == "__main__":

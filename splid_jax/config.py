@@ -24,8 +24,8 @@ class TrainConfig:
     sigma: float = _f(1.0, "std of the Gaussian exploration noise added to the policy's action")
     horizon: int = _f(8, "learning horizon H: hindsight goals come from 1..H steps ahead")
     select: bool = _f(True, "SELECT by first hit time; --no-select stores every relabelled pair (ablation)")
-    select_budget: float = _f(
-        None, "fraction of the T x N starts SELECT replays per h, filled with valid candidates at random (1: all)"
+    select_lanes: float = _f(
+        None, "parallel SELECT replay lanes as a fraction of the T x N explored steps (speed only, never a verdict)"
     )
     buffer_size: int = _f(None, "relabel buffer capacity (FIFO)")
     batch_size: int = _f(None, "behaviour-cloning minibatch size")
@@ -52,7 +52,7 @@ class TrainConfig:
         check(self.num_envs >= 1, "num_envs", self.num_envs, "an integer >= 1")
         check(self.sigma >= 0, "sigma", self.sigma, ">= 0")
         check(self.horizon >= 1, "horizon", self.horizon, "an integer >= 1 (and < the episode length)")
-        check(0 < self.select_budget <= 1, "select_budget", self.select_budget, "in (0, 1]")
+        check(0 < self.select_lanes <= 1, "select_lanes", self.select_lanes, "in (0, 1]")
         check(self.buffer_size >= 1, "buffer_size", self.buffer_size, "an integer >= 1")
         check(self.batch_size >= 1, "batch_size", self.batch_size, "an integer >= 1")
         check(self.bc_steps >= 0, "bc_steps", self.bc_steps, "an integer >= 0")
@@ -90,7 +90,7 @@ class TrainConfig:
 
 _POINT = dict(
     iterations=100,
-    select_budget=1.0,
+    select_lanes=1.0,
     num_envs=32,
     buffer_size=200_000,
     batch_size=256,
@@ -103,7 +103,7 @@ _POINT = dict(
 )
 _FETCH = dict(
     iterations=200,
-    select_budget=0.35,
+    select_lanes=1.0,
     num_envs=256,
     buffer_size=1_000_000,
     batch_size=1024,

@@ -1,12 +1,15 @@
 """Stage 2 of Algorithm 2: hindsight relabelling and SELECT by first hit time.
 
 For every explored step t and every h in 1..H the candidate is (s_t, g' = m(s_{t+h}), a_t). SELECT
-restores s_t pursuing g' and runs the current deterministic policy for h steps: if the policy
+restores s_t pursuing g' and runs the current deterministic policy for up to h steps: if the policy
 reaches g', the explored actions were no faster and the pair is rejected.
 
-Layout: candidates are [H, T, N] (h-major), flattened. A ``lax.scan`` over h replays all T x N
-candidates of one h in one vmapped loop of exactly h steps, so the simulator step appears once in
-the compiled program (MJX compile time) and no step is simulated past its own horizon."""
+Most candidates need no replay (the object did not move: the policy "reaches" g' in zero steps), and
+a replay ends as soon as the policy hits g'. So SELECT runs as a work queue: a fixed number of
+vmapped replay lanes, each taking the next valid candidate from the queue as soon as its current one
+is decided, in one ``lax.while_loop`` that ends when the queue is empty. Every valid candidate is
+decided, no lane steps past its verdict, and the simulator step appears once in the compiled
+program (MJX compile time)."""
 
 from __future__ import annotations
 
@@ -23,17 +26,17 @@ from splid_jax.networks import Policy, PolicyState
 class Candidates(NamedTuple):
     """Flat batch of relabelled pairs; the layout is static, validity lives in masks."""
 
-    obs: jax.Array  # [M, O], M = H * T * N
+    obs: jax.Array  # [M, O], M = H * T * N, layout [H, T, N]
     goal: jax.Array  # [M, G]
     action: jax.Array  # [M, A]
     valid: jax.Array  # [M] a real candidate: t + h <= T, the goal moved, no NaN, h <= horizon
-    accept: jax.Array  # [M] valid, replayed, and not solved by the current policy within h steps
-    dropped: jax.Array  # [] int32, valid candidates left undecided because the replay budget was full
+    accept: jax.Array  # [M] valid and not solved by the current policy within h steps
+    replay_steps: jax.Array  # [] int32, simulator control steps the replays took
 
 
 def policy_reaches(env: GoalEnv, policy: Policy, pstate: PolicyState, state: State, goal: jax.Array, h):
-    """Whether the deterministic policy, restored at ``state``, hits ``goal`` within ``h`` steps
-    (``h`` may be traced: the loop runs exactly h steps)."""
+    """Whether the deterministic policy, restored at ``state``, hits ``goal`` within ``h`` steps:
+    the definition the work queue must agree with (tests compare them)."""
 
     def one_step(_, carry):
         s, hit = carry
@@ -48,14 +51,81 @@ def num_candidates(episode_length: int, max_horizon: int, num_envs: int) -> int:
     return max_horizon * episode_length * num_envs
 
 
-def replay_slots(episode_length: int, num_envs: int, budget: float) -> int:
-    """Candidates replayed per h: all T x N starts, or the ``budget`` fraction of them."""
-    return max(1, min(episode_length * num_envs, int(round(budget * episode_length * num_envs))))
+def num_lanes(episode_length: int, num_envs: int, lanes: float) -> int:
+    """Parallel replay lanes: the ``lanes`` fraction of the T x N explored steps."""
+    return max(1, min(episode_length * num_envs, int(round(lanes * episode_length * num_envs))))
 
 
-def replay_steps(episode_length: int, horizon: int, num_envs: int, budget: float = 1.0) -> int:
-    """Simulator steps SELECT takes per iteration: h steps for each replayed slot, per h."""
-    return replay_slots(episode_length, num_envs, budget) * horizon * (horizon + 1) // 2
+class _Queue(NamedTuple):
+    state: State  # [L] the lanes' simulator states
+    cand: jax.Array  # [L] int32, the candidate each lane decides
+    steps: jax.Array  # [L] int32, steps taken on it
+    active: jax.Array  # [L] bool
+    next: jax.Array  # [] int32, queue position of the next candidate to hand out
+    reached: jax.Array  # [M + 1] bool, verdicts; the last slot absorbs writes of idle lanes
+    replay_steps: jax.Array  # [] int32
+
+
+def replay_queue(
+    env: GoalEnv,
+    policy: Policy,
+    pstate: PolicyState,
+    starts: State,
+    goals: jax.Array,
+    start_of: jax.Array,
+    horizon_of: jax.Array,
+    valid: jax.Array,
+    lanes: int,
+) -> tuple[jax.Array, jax.Array]:
+    """For every valid candidate c: does the policy, restored at ``starts[start_of[c]]`` pursuing
+    ``goals[c]``, hit it within ``horizon_of[c]`` steps? Returns (reached [M], replay steps [])."""
+    m = valid.shape[0]
+    # longest replays first: the lanes that finish last are then the short ones
+    order = jnp.argsort(jnp.where(valid, -horizon_of, 1), stable=True).astype(jnp.int32)
+    count = jnp.sum(valid, dtype=jnp.int32)
+    lane = jnp.arange(lanes, dtype=jnp.int32)
+
+    def restore(cand):  # [L] candidates -> their start states, pursuing their goals
+        return jax.vmap(env.with_goal)(jax.tree_util.tree_map(lambda x: x[start_of[cand]], starts), goals[cand])
+
+    def load(state, cand, take):
+        pick = lambda new, old: jnp.where(take.reshape(take.shape + (1,) * (new.ndim - 1)), new, old)  # noqa: E731
+        return jax.tree_util.tree_map(pick, restore(cand), state)
+
+    first = order[jnp.minimum(lane, m - 1)]
+    active = lane < count
+    q = _Queue(
+        restore(first),
+        first,
+        jnp.zeros(lanes, jnp.int32),
+        active,
+        jnp.minimum(count, lanes),
+        jnp.zeros(m + 1, bool),
+        jnp.int32(0),
+    )
+
+    def body(q: _Queue) -> _Queue:
+        s = jax.vmap(env.step)(q.state, policy.act(pstate, q.state.obs, q.state.desired_goal))
+        steps = q.steps + 1
+        hit = s.success & ~s.invalid
+        done = q.active & (hit | (steps >= horizon_of[q.cand]))
+        reached = q.reached.at[jnp.where(done, q.cand, m)].set(hit)
+        # finished lanes take the next candidates in queue order
+        pos = q.next + jnp.cumsum(done, dtype=jnp.int32) - 1
+        take = done & (pos < count)
+        cand = jnp.where(take, order[jnp.clip(pos, 0, m - 1)], q.cand)
+        return _Queue(
+            state=load(s, cand, take),
+            cand=cand,
+            steps=jnp.where(done, 0, steps),
+            active=jnp.where(done, take, q.active),
+            next=jnp.minimum(q.next + jnp.sum(done, dtype=jnp.int32), count),
+            reached=reached,
+            replay_steps=q.replay_steps + jnp.sum(q.active, dtype=jnp.int32),
+        )
+
+    q = jax.lax.while_loop(lambda q: jnp.any(q.active), body, q)
+    return q.reached[:m], q.replay_steps
 
 
 def select(
@@ -66,17 +136,12 @@ def select(
     max_horizon: int,
     horizon: jax.Array,
     use_select: bool,
-    key: jax.Array | None = None,
-    budget: float = 1.0,
+    lanes: float = 1.0,
 ) -> Candidates:
-    """``max_horizon`` fixes the shapes; ``horizon`` (traced, <= max_horizon) masks and skips
-    the replays of larger h, so runs with different H share one compiled program.
-    ``use_select=False`` is the ablation: every valid pair is stored, nothing is replayed.
-
-    ``budget`` < 1 replays, per h, only that fraction of the T x N slots, filled with valid
-    candidates chosen uniformly at random (``key``): most candidates of object tasks are invalid
-    (the object did not move), and replaying them is wasted work. Valid candidates beyond the
-    budget are left undecided (not stored) and counted in ``dropped``."""
+    """``max_horizon`` fixes the shapes; ``horizon`` (traced, <= max_horizon) masks the candidates
+    of larger h, so runs with different H share one compiled program. ``use_select=False`` is the
+    ablation: every valid pair is stored, nothing is replayed. ``lanes`` sets the width of the
+    replay batch as a fraction of the T x N explored steps; it changes speed, never a verdict."""
     T, H = env.episode_length, max_horizon
     n = traj.actions.shape[1]
     hs = jnp.arange(1, H + 1)
@@ -90,33 +155,15 @@ def select(
         & ~traj.invalid[later]
         & (hs <= horizon)[:, None, None]
     ).reshape(-1)
-    goal = goal.reshape(H, T * n, -1)
-    dropped = jnp.int32(0)
+    goal = goal.reshape(H * T * n, -1)
     if use_select:
         starts = jax.tree_util.tree_map(lambda x: x.reshape((T * n,) + x.shape[2:]), traj.states)
-        replay = jax.vmap(lambda s, g, h: policy_reaches(env, policy, pstate, s, g, h), in_axes=(0, 0, None))
-        valid_h = valid.reshape(H, T * n)
-        slots = replay_slots(T, n, budget)
-        if slots < T * n:
-            key = jax.random.PRNGKey(0) if key is None else key
-            # a random priority among valid candidates; invalid ones sort last
-            score = jax.random.uniform(key, valid_h.shape) + valid_h.astype(jnp.float32)
-            chosen = jax.lax.top_k(score, slots)[1]  # [H, slots]
-            decided = jnp.zeros_like(valid_h).at[jnp.arange(H)[:, None], chosen].set(True) & valid_h
-            dropped = jnp.sum(valid_h & ~decided, dtype=jnp.int32)
-        else:
-            chosen = jnp.broadcast_to(jnp.arange(T * n), (H, T * n))
-            decided = valid_h
-
-        def per_h(_, xs):
-            h, goal_h, idx = xs
-            picked = jax.tree_util.tree_map(lambda x: x[idx], starts)
-            hit = replay(picked, goal_h[idx], jnp.where(h <= horizon, h, 0))
-            return None, jnp.zeros(T * n, bool).at[idx].set(hit)
-
-        _, reached = jax.lax.scan(per_h, None, (hs, goal, chosen))
-        accept = (decided & ~reached).reshape(-1)
+        flat = jnp.arange(H * T * n, dtype=jnp.int32)
+        reached, steps = replay_queue(
+            env, policy, pstate, starts, goal, flat % (T * n), flat // (T * n) + 1, valid, num_lanes(T, n, lanes)
+        )
+        accept = valid & ~reached
     else:
-        accept = valid
+        accept, steps = valid, jnp.int32(0)
     tile = lambda x: jnp.broadcast_to(x[None], (H,) + x.shape).reshape((H * T * n,) + x.shape[2:])  # noqa: E731
-    return Candidates(tile(traj.states.obs), goal.reshape(H * T * n, -1), tile(traj.actions), valid, accept, dropped)
+    return Candidates(tile(traj.states.obs), goal, tile(traj.actions), valid, accept, steps)

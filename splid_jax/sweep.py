@@ -16,6 +16,7 @@ import time
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from envs.base import InvalidConfig, check
 from splid_jax import plot, progress
@@ -63,6 +64,7 @@ def run_sweep(cfg: TrainConfig, grid: list[Member], quiet: bool = False) -> list
         open(os.path.join(d, "metrics.jsonl"), "w").close()
     progress.show(f"sweep: {len(grid)} members of {cfg.env} in one program, {cfg.iterations} iterations", quiet)
     start, iteration, last = time.perf_counter(), 0, []
+    totals = [0] * len(grid)  # SELECT replay steps per member, exact Python ints
     while iteration < cfg.iterations:
         t0 = time.perf_counter()
         state, metrics = chunk(state, hyper)
@@ -70,8 +72,10 @@ def run_sweep(cfg: TrainConfig, grid: list[Member], quiet: bool = False) -> list
         chunk_s, iteration = time.perf_counter() - t0, iteration + cfg.eval_every
         wall = time.perf_counter() - start
         last = []
-        for i, (d, m) in enumerate(zip(dirs, grid, strict=True)):
-            rec = trainer.counters(iteration, horizon=m.horizon)
+        per_iter = np.asarray(metrics.pop("select_steps"), np.int64)  # [members, eval_every]
+        for i, d in enumerate(dirs):
+            totals[i] += int(per_iter[i].sum())
+            rec = trainer.counters(iteration, totals[i])
             rec.update({k: v[i].item() for k, v in metrics.items() if k != "finite"})
             rec.update(finite=bool(metrics["finite"][i]), wall_s=wall, chunk_s=chunk_s)
             with open(os.path.join(d, "metrics.jsonl"), "a") as fh:

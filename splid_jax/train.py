@@ -46,12 +46,19 @@ def _identity(cfg: TrainConfig) -> dict:
     return json.loads(json.dumps(ident))
 
 
-def _record(trainer: Trainer, metrics: dict, wall_s: float, chunk_s: float, iteration: int) -> dict:
-    rec = trainer.counters(iteration)
+def chunk_select_steps(metrics: dict) -> int:
+    """Pops the chunk's per-iteration SELECT replay steps and sums them as a Python int."""
+    return int(np.asarray(metrics.pop("select_steps"), np.int64).sum())
+
+
+def _record(
+    trainer: Trainer, metrics: dict, wall_s: float, chunk_s: float, iteration: int, total: int, chunk_steps: int
+) -> dict:
+    """One metrics line; ``total`` SELECT replay steps in the run so far, ``chunk_steps`` in this chunk."""
+    rec = trainer.counters(iteration, total)
     for k, v in metrics.items():
         rec[k] = v.item()
-    one = trainer.counters(1)
-    steps = trainer.cfg.eval_every * (one["env_steps"] + one["select_steps"])
+    steps = trainer.cfg.eval_every * trainer.cfg.num_envs * trainer.env.episode_length + chunk_steps
     rec["buffer_fill"] = rec["buffer_size"] / trainer.cfg.buffer_size
     rec["steps_per_s"] = steps / max(chunk_s, 1e-9)
     rec["wall_s"] = wall_s
@@ -66,12 +73,13 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
     os.makedirs(cfg.run_dir, exist_ok=True)
     metrics_path = os.path.join(cfg.run_dir, "metrics.jsonl")
     state = trainer.init(jax.random.PRNGKey(cfg.seed))
-    wall_before = 0.0
+    wall_before, select_steps = 0.0, 0
     if resume:
         # the meta check comes first, so a changed setting is named rather than a leaf's shape
         step, state, meta = checkpoint.restore(cfg.run_dir, state, expect_meta={"config": _identity(cfg)})
         wall_before = float(meta["wall_s"])
         kept = [r for r in _read_jsonl(metrics_path) if r["iteration"] <= step]
+        select_steps = int(meta.get("select_steps", kept[-1]["select_steps"] if kept else 0))
         _write_jsonl(metrics_path, kept)
         progress.show(f"resumed {cfg.run_dir} at iteration {step}", quiet)
     else:
@@ -86,8 +94,8 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
     start = time.perf_counter()
     rec, chunks_done = {}, 0
 
-    def save(st, it):
-        meta = {"config": _identity(cfg), "wall_s": wall_before + time.perf_counter() - start}
+    def save(st, it, total):
+        meta = {"config": _identity(cfg), "wall_s": wall_before + time.perf_counter() - start, "select_steps": total}
         with _interrupt_after():
             checkpoint.save(cfg.run_dir, it, st, meta)
 
@@ -103,21 +111,25 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
                     f"stopped, the last good checkpoint (iteration {iteration}) is kept in {cfg.run_dir}"
                 )
             done = iteration + cfg.eval_every
-            rec = _record(trainer, metrics, wall_before + time.perf_counter() - start, chunk_s, done)
+            chunk_steps = chunk_select_steps(metrics)
+            new_total = select_steps + chunk_steps
+            rec = _record(
+                trainer, metrics, wall_before + time.perf_counter() - start, chunk_s, done, new_total, chunk_steps
+            )
             with open(metrics_path, "a") as fh:  # a line past the checkpoint is dropped on resume
                 fh.write(json.dumps(rec) + "\n")
-            state, iteration, chunks_done = new_state, done, chunks_done + 1
+            state, iteration, chunks_done, select_steps = new_state, done, chunks_done + 1, new_total
             progress.show(progress.line(rec, cfg.iterations), quiet)
             if iteration == cfg.iterations or (cfg.checkpoint_every and chunks_done % cfg.checkpoint_every == 0):
-                save(state, iteration)
+                save(state, iteration, select_steps)
     except KeyboardInterrupt:
         if checkpoint.latest_step(cfg.run_dir) != iteration:
-            save(state, iteration)
+            save(state, iteration, select_steps)
         progress.show(f"interrupted: saved iteration {iteration} to {cfg.run_dir}; resume with --resume", quiet)
         raise
     except RunStopped:
         if checkpoint.latest_step(cfg.run_dir) != iteration:
-            save(state, iteration)
+            save(state, iteration, select_steps)
         raise
     return rec
 

@@ -15,7 +15,7 @@ from splid_jax.config import TrainConfig
 from splid_jax.evaluate import evaluate
 from splid_jax.explore import explore
 from splid_jax.networks import PolicyState, make_policy
-from splid_jax.select import replay_steps, select
+from splid_jax.select import select
 
 
 @struct.dataclass
@@ -67,11 +67,9 @@ class Trainer:
 
     def iteration(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
         env, cfg, policy = self.env, self.cfg, self.policy
-        key, k_explore, k_select, k_bc = jax.random.split(ts.key, 4)
+        key, k_explore, k_bc = jax.random.split(ts.key, 3)
         traj = explore(env, policy, ts.policy, k_explore, cfg.num_envs, hyper.sigma)
-        cands = select(
-            env, policy, ts.policy, traj, self.max_horizon, hyper.horizon, cfg.select, k_select, cfg.select_budget
-        )
+        cands = select(env, policy, ts.policy, traj, self.max_horizon, hyper.horizon, cfg.select, cfg.select_lanes)
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
         pstate = policy.update_normaliser(ts.policy, traj.states.obs, traj.achieved[:-1], ~traj.invalid[:-1])
         pstate, opt_state, loss = bc_epoch(
@@ -80,7 +78,7 @@ class Trainer:
         metrics = {
             "select_pairs": jnp.sum(cands.valid, dtype=jnp.int32),
             "select_accepted": jnp.sum(cands.accept, dtype=jnp.int32),
-            "select_dropped": cands.dropped,
+            "select_steps": cands.replay_steps,
             "bc_loss": loss,
             "explore_success": jnp.mean(jnp.any(traj.states.success, axis=0)),
         }
@@ -95,7 +93,7 @@ class Trainer:
         metrics.update(
             select_pairs=jnp.sum(per_iter["select_pairs"]),
             select_accepted=jnp.sum(per_iter["select_accepted"]),
-            select_dropped=jnp.sum(per_iter["select_dropped"]),
+            select_steps=per_iter["select_steps"],  # [eval_every]: summed on the host, where ints do not overflow
             bc_loss=per_iter["bc_loss"][-1],
             explore_success=jnp.mean(per_iter["explore_success"]),
             buffer_size=ts.buffer.size,
@@ -103,16 +101,15 @@ class Trainer:
         )
         return ts.replace(key=key), metrics
 
-    def counters(self, iteration: int, horizon: int | None = None) -> dict:
-        """Work done after ``iteration`` iterations, as exact Python ints (no int32 overflow)."""
-        cfg, T = self.cfg, self.env.episode_length
-        h = cfg.horizon if horizon is None else horizon
-        per_iter = replay_steps(T, h, cfg.num_envs, cfg.select_budget) if cfg.select else 0
+    def counters(self, iteration: int, select_steps: int) -> dict:
+        """Work done after ``iteration`` iterations, as exact Python ints: exploration episodes and env
+        steps, and the SELECT replay steps counted on the device (``select_steps``, summed by the caller)."""
+        cfg = self.cfg
         return {
             "iteration": iteration,
             "episodes": iteration * cfg.num_envs,
-            "env_steps": iteration * cfg.num_envs * T,
-            "select_steps": iteration * per_iter,
+            "env_steps": iteration * cfg.num_envs * self.env.episode_length,
+            "select_steps": select_steps,
         }
 
 

@@ -10,7 +10,7 @@ import envs
 from envs.base import State
 from splid_jax.explore import Trajectory, explore
 from splid_jax.networks import make_policy
-from splid_jax.select import num_candidates, select
+from splid_jax.select import num_candidates, policy_reaches, select
 
 T, H = 10, 5
 
@@ -99,21 +99,35 @@ def test_explore_shapes_and_noise(env):
     np.testing.assert_array_equal(quiet.actions, 0.0)
 
 
-def test_replay_budget_decides_a_random_subset_of_valid_candidates(env):
+def test_work_queue_gives_every_valid_candidate_the_verdict_of_its_own_replay(env):
+    """Against ``policy_reaches`` run on each candidate alone, at several lane counts: lanes change
+    the speed, never a verdict, and no lane steps past a verdict."""
+    policy = make_policy(env.obs_size, env.goal_size, env.action_size, (16,), normalise=False)
+    pstate = policy.init(jax.random.PRNGKey(3))
+    n = 6
+    traj = explore(env, policy, pstate, jax.random.PRNGKey(1), n, jnp.float32(1.0))
+    starts = jax.tree_util.tree_map(lambda x: x.reshape((T * n,) + x.shape[2:]), traj.states)
+    results = [select(env, policy, pstate, traj, H, jnp.int32(H), True, lanes) for lanes in (0.02, 0.3, 1.0)]
+    c = results[0]
+    idx = jnp.arange(H * T * n)
+    alone = jax.vmap(
+        lambda i: policy_reaches(
+            env, policy, pstate, jax.tree_util.tree_map(lambda x: x[i % (T * n)], starts), c.goal[i], i // (T * n) + 1
+        )
+    )(idx)
+    expected = np.asarray(c.valid & ~alone)
+    assert 0 < expected.sum() < np.asarray(c.valid).sum()  # both verdicts occur
+    hs = np.asarray(idx // (T * n) + 1)
+    for r in results:
+        np.testing.assert_array_equal(r.accept, expected)
+        # a rejected candidate stops at its hit, an accepted one runs its full h
+        assert int(r.replay_steps) < hs[np.asarray(c.valid)].sum()
+        assert int(r.replay_steps) >= hs[expected].sum()
+    assert len({int(r.replay_steps) for r in results}) == 1
+
+
+def test_no_valid_candidate_means_no_replay(env):
     policy, pstate = constant_policy(env, [1.0, 0.0])
-    starts = jnp.full((3, 2), -4.8)
-    traj = scripted_trajectory(env, starts, jnp.array([[0.4, 0.0], [0.0, 0.4], [0.3, 0.3]]))
-    full = select(env, policy, pstate, traj, H, jnp.int32(H), True)
-    valid_per_h = np.asarray(full.valid).reshape(H, -1).sum(axis=1)
-    # a budget with room for every valid candidate decides exactly what the full replay decides
-    roomy = select(env, policy, pstate, traj, H, jnp.int32(H), True, jax.random.PRNGKey(1), 0.9)
-    assert valid_per_h.max() <= round(0.9 * T * 3)
-    np.testing.assert_array_equal(roomy.accept, full.accept)
-    assert int(roomy.dropped) == 0
-    # a tight budget replays 3 slots per h: the rest of the valid candidates are dropped, never stored
-    tight = select(env, policy, pstate, traj, H, jnp.int32(H), True, jax.random.PRNGKey(1), 0.1)
-    decided = np.minimum(valid_per_h, 3).sum()
-    assert int(tight.dropped) == valid_per_h.sum() - decided
-    accept = np.asarray(tight.accept)
-    assert not (accept & ~np.asarray(full.accept)).any()  # a stored pair is one the full replay accepts
-    assert 0 < accept.sum() <= decided
+    traj = scripted_trajectory(env, jnp.full((2, 2), -4.8), jnp.zeros((2, 2)))  # nothing moves
+    cands = select(env, policy, pstate, traj, H, jnp.int32(H), True)
+    assert not np.asarray(cands.valid).any() and int(cands.replay_steps) == 0

@@ -21,7 +21,7 @@ def run_chunks(trainer, seed, chunks):
     state, out = trainer.init(jax.random.PRNGKey(seed)), []
     for _ in range(chunks):
         state, metrics = trainer.chunk(state, trainer.hyper())
-        out.append({k: float(v) for k, v in jax.device_get(metrics).items()})
+        out.append({k: float(np.sum(v)) for k, v in jax.device_get(metrics).items()})  # select_steps: per iteration
     return state, out
 
 
