@@ -211,7 +211,10 @@ def figure(runs: Sequence[Run], k: int = 1, group: bool = False, steps: str = "e
     axes[0, 0].set_ylabel("eval success (solid: any step, dashed: final step)")
     axes[1, 0].set_ylabel("eval return")
     axes[0, 0].set_ylim(-0.02, 1.02)
-    axes[0, 0].legend(fontsize="small", loc="best")
+    handles, names = axes[0, 0].get_legend_handles_labels()
+    if handles:  # below the panels: long sweep labels would cover the curves inside an axis
+        ncols = max(1, min(len(names), 150 // max(len(n) for n in names)))
+        fig.legend(handles, names, loc="outside lower center", ncols=ncols, fontsize="small")
     title = "min-max band over seeds" if group else ""
     if k > 1:
         title = f"{title}, " if title else ""
