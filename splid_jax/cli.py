@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
+
+import jax
 
 
 def _int_tuple(text: str) -> tuple[int, ...]:
@@ -43,3 +46,25 @@ def _show(value) -> str:
 def explicit_values(cls, namespace: argparse.Namespace) -> dict:
     names = {f.name for f in dataclasses.fields(cls)}
     return {k: v for k, v in vars(namespace).items() if k in names and v is not None}
+
+
+def default_compile_cache() -> str:
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(base, "splid_jax", "jax")
+
+
+def add_compile_cache_flag(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--compile-cache",
+        metavar="DIR",
+        default=default_compile_cache(),
+        help="keep compiled programs in DIR, so a rerun with the same task and shapes skips most of "
+        "its compilation ('' turns it off; default: %(default)s)",
+    )
+
+
+def use_compile_cache(path: str) -> None:
+    """JAX's persistent compilation cache: MJX programs take tens of seconds to compile and are
+    the same from one run of a setting to the next."""
+    if path:  # programs that compile in under a second are not kept (JAX's default threshold)
+        jax.config.update("jax_compilation_cache_dir", path)

@@ -15,6 +15,7 @@ import numpy as np
 
 from envs.base import InvalidConfig
 from splid_jax import checkpoint
+from splid_jax.cli import add_compile_cache_flag, use_compile_cache
 from splid_jax.config import TrainConfig
 from splid_jax.train import make_env
 from splid_jax.trainer import Trainer
@@ -107,7 +108,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--episodes", type=int, default=16, help="episodes to roll out (default: 16)")
     p.add_argument("--seed", type=int, default=123, help="seed of the episodes' starts and goals")
     p.add_argument("--out", default=None, help="figure of the paths (default: RUN_DIR/rollout.png)")
+    add_compile_cache_flag(p)
     a = p.parse_args(argv)
+    use_compile_cache(a.compile_cache)
     try:
         if a.episodes < 1:
             raise InvalidConfig("episodes", a.episodes, "an integer >= 1")

@@ -20,7 +20,7 @@ import numpy as np
 
 from envs.base import InvalidConfig, check
 from splid_jax import plot, progress
-from splid_jax.cli import add_config_flags, explicit_values
+from splid_jax.cli import add_compile_cache_flag, add_config_flags, explicit_values, use_compile_cache
 from splid_jax.config import TASK_DEFAULTS, TrainConfig
 from splid_jax.train import make_env
 from splid_jax.trainer import Hyper, Trainer
@@ -103,7 +103,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--horizons", default="8", help="comma-separated H values (default: 8)")
     parser.add_argument("--no-plot", action="store_true", help="skip the grid figure")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
+    add_compile_cache_flag(parser)
     ns = parser.parse_args(argv)
+    use_compile_cache(ns.compile_cache)
     try:
         given = explicit_values(TrainConfig, ns)
         given.setdefault("run_dir", os.path.join("runs", f"sweep-{given.get('env', 'point')}"))

@@ -21,7 +21,7 @@ import numpy as np
 import envs
 from envs.base import InvalidConfig
 from splid_jax import checkpoint, progress
-from splid_jax.cli import add_config_flags, explicit_values
+from splid_jax.cli import add_compile_cache_flag, add_config_flags, explicit_values, use_compile_cache
 from splid_jax.config import TASK_DEFAULTS, TrainConfig
 from splid_jax.trainer import Trainer
 
@@ -171,6 +171,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_config_flags(parser, TrainConfig, TASK_DEFAULTS)
     parser.add_argument("--resume", metavar="RUN_DIR", help="continue the run saved in RUN_DIR (its config.json)")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
+    add_compile_cache_flag(parser)
     return parser
 
 
@@ -198,6 +199,7 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     ns = parser.parse_args(argv)
+    use_compile_cache(ns.compile_cache)
     try:
         cfg, resume = config_from_cli(ns)
         env = make_env(cfg.env, **cfg.env_overrides())

@@ -106,6 +106,20 @@ def test_resume_after_kill_matches_an_uninterrupted_run(tmp_path):
         np.testing.assert_array_equal(a, b)
 
 
+def test_a_rerun_compiles_nothing_new_and_repeats_the_run(tmp_path):
+    cache = str(tmp_path / "cache")
+    args = [*TINY, "--iterations", "10", "--quiet", "--checkpoint-every", "0", "--compile-cache", cache]
+    env = {**os.environ, "JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS": "0"}  # keep even fast compiles
+    first = cli(*args, "--run-dir", str(tmp_path / "first"), env=env)
+    assert first.wait() == 0, first.stderr.read()
+    kept = sorted(os.listdir(cache))
+    assert any("chunk" in name for name in kept)
+    again = cli(*args, "--run-dir", str(tmp_path / "again"), env=env)
+    assert again.wait() == 0, again.stderr.read()
+    assert sorted(os.listdir(cache)) == kept  # every program came from the cache
+    assert stable(str(tmp_path / "again")) == stable(str(tmp_path / "first"))
+
+
 @pytest.mark.slow
 def test_ctrl_c_saves_and_exits_cleanly(tmp_path):
     run_dir = str(tmp_path / "run")
