@@ -33,16 +33,17 @@ from splid_jax.trainer import Trainer
 
 
 def timed(fn, *args, repeats: int):
+    """Timings of ``fn(*args)``, and its last output."""
     t0 = time.perf_counter()
     jax.block_until_ready(fn(*args))
     first = time.perf_counter() - t0
     times = []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        jax.block_until_ready(fn(*args))
+        out = jax.block_until_ready(fn(*args))
         times.append(time.perf_counter() - t0)
     med = statistics.median(times)
-    return {"median_s": med, "compile_s": max(first - med, 0.0), "runs": len(times)}
+    return {"median_s": med, "compile_s": max(first - med, 0.0), "runs": len(times)}, out
 
 
 def trained_policy(env, cfg: TrainConfig, iterations: int):
@@ -79,8 +80,7 @@ def bench_select(env, cfg: TrainConfig, device, repeats: int, pstate=None) -> di
                 cfg.select_lanes,
             )
         )
-        out = timed(fn, pstate, traj, repeats=repeats)
-        cands = fn(pstate, traj)
+        out, cands = timed(fn, pstate, traj, repeats=repeats)
     T, H, N = env.episode_length, cfg.horizon, cfg.num_envs
     pairs = N * sum(T - h + 1 for h in range(1, H + 1))  # (t, h) with t + h <= T
     verdicts, steps = int(cands.valid.sum()), int(cands.replay_steps)
@@ -103,11 +103,11 @@ def bench_select(env, cfg: TrainConfig, device, repeats: int, pstate=None) -> di
 def bench_chunk(env, cfg: TrainConfig, seeds: int, repeats: int) -> dict:
     """Time whole compiled chunks (explore, SELECT, insert, BC, eval) for 1 seed and ``seeds`` seeds."""
     trainer = Trainer(env, cfg)
-    one = timed(trainer.chunk, trainer.init(jax.random.PRNGKey(0)), trainer.hyper(), repeats=repeats)
+    one, _ = timed(trainer.chunk, trainer.init(jax.random.PRNGKey(0)), trainer.hyper(), repeats=repeats)
     keys = jnp.stack([jax.random.PRNGKey(s) for s in range(seeds)])
     states = jax.vmap(trainer.init)(keys)
     hyper = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (seeds,)), trainer.hyper())
-    many = timed(jax.jit(jax.vmap(trainer._chunk)), states, hyper, repeats=repeats)
+    many, _ = timed(jax.jit(jax.vmap(trainer._chunk)), states, hyper, repeats=repeats)
     return {
         "num_envs": cfg.num_envs,
         "iterations_per_chunk": cfg.eval_every,

@@ -16,13 +16,12 @@ import time
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 from envs.base import InvalidConfig, check
 from splid_jax import plot, progress
 from splid_jax.cli import add_compile_cache_flag, add_config_flags, explicit_values, use_compile_cache
 from splid_jax.config import TASK_DEFAULTS, TrainConfig
-from splid_jax.train import make_env
+from splid_jax.train import make_env, pop_select_steps
 from splid_jax.trainer import Hyper, Trainer
 
 
@@ -72,9 +71,9 @@ def run_sweep(cfg: TrainConfig, grid: list[Member], quiet: bool = False) -> list
         chunk_s, iteration = time.perf_counter() - t0, iteration + cfg.eval_every
         wall = time.perf_counter() - start
         last = []
-        per_iter = np.asarray(metrics.pop("select_steps"), np.int64)  # [members, eval_every]
+        per_member = pop_select_steps(metrics)
         for i, d in enumerate(dirs):
-            totals[i] += int(per_iter[i].sum())
+            totals[i] += int(per_member[i])
             rec = trainer.counters(iteration, totals[i])
             rec.update({k: v[i].item() for k, v in metrics.items() if k != "finite"})
             rec.update(finite=bool(metrics["finite"][i]), wall_s=wall, chunk_s=chunk_s)

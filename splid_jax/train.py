@@ -46,9 +46,10 @@ def _identity(cfg: TrainConfig) -> dict:
     return json.loads(json.dumps(ident))
 
 
-def chunk_select_steps(metrics: dict) -> int:
-    """Pops the chunk's per-iteration SELECT replay steps and sums them as a Python int."""
-    return int(np.asarray(metrics.pop("select_steps"), np.int64).sum())
+def pop_select_steps(metrics: dict) -> np.ndarray:
+    """Pops a chunk's per-iteration SELECT replay steps ([..., eval_every], int32 on the device) and
+    sums them over the iterations in int64 (per member of a sweep, where there is a member axis)."""
+    return np.asarray(metrics.pop("select_steps"), np.int64).sum(axis=-1)
 
 
 def _record(
@@ -58,7 +59,8 @@ def _record(
     rec = trainer.counters(iteration, total)
     for k, v in metrics.items():
         rec[k] = v.item()
-    steps = trainer.cfg.eval_every * trainer.cfg.num_envs * trainer.env.episode_length + chunk_steps
+    chunk = trainer.counters(trainer.cfg.eval_every, chunk_steps)
+    steps = chunk["env_steps"] + chunk["select_steps"]
     rec["buffer_fill"] = rec["buffer_size"] / trainer.cfg.buffer_size
     rec["steps_per_s"] = steps / max(chunk_s, 1e-9)
     rec["wall_s"] = wall_s
@@ -79,7 +81,7 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
         step, state, meta = checkpoint.restore(cfg.run_dir, state, expect_meta={"config": _identity(cfg)})
         wall_before = float(meta["wall_s"])
         kept = [r for r in _read_jsonl(metrics_path) if r["iteration"] <= step]
-        select_steps = int(meta.get("select_steps", kept[-1]["select_steps"] if kept else 0))
+        select_steps = int(meta["select_steps"])
         _write_jsonl(metrics_path, kept)
         progress.show(f"resumed {cfg.run_dir} at iteration {step}", quiet)
     else:
@@ -111,7 +113,7 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
                     f"stopped, the last good checkpoint (iteration {iteration}) is kept in {cfg.run_dir}"
                 )
             done = iteration + cfg.eval_every
-            chunk_steps = chunk_select_steps(metrics)
+            chunk_steps = int(pop_select_steps(metrics))
             new_total = select_steps + chunk_steps
             rec = _record(
                 trainer, metrics, wall_before + time.perf_counter() - start, chunk_s, done, new_total, chunk_steps
