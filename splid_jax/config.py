@@ -31,6 +31,11 @@ class TrainConfig:
     batch_size: int = _f(None, "behaviour-cloning minibatch size")
     bc_steps: int = _f(None, "behaviour-cloning gradient steps per iteration")
     learning_rate: float = _f(None, "Adam learning rate of the behaviour-cloning step")
+    policy_ema: float = _f(
+        None,
+        "Polyak average of the cloned parameters that acts (explore, SELECT, eval): "
+        "acting = d * acting + (1 - d) * cloned after each BC step; 0 acts with the cloned ones",
+    )
     hidden: tuple[int, ...] = _f(None, "hidden layer widths of the policy MLP, e.g. 64,64,64")
     normalise: bool = _f(None, "normalise policy inputs with running mean and std")
     eval_every: int = _f(None, "iterations per compiled chunk; evaluation, logging and checkpoints come between")
@@ -57,6 +62,7 @@ class TrainConfig:
         check(self.batch_size >= 1, "batch_size", self.batch_size, "an integer >= 1")
         check(self.bc_steps >= 0, "bc_steps", self.bc_steps, "an integer >= 0")
         check(self.learning_rate > 0, "learning_rate", self.learning_rate, "> 0")
+        check(0 <= self.policy_ema < 1, "policy_ema", self.policy_ema, "in [0, 1)")
         check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "hidden", self.hidden, "one or more widths >= 1")
         check(self.eval_every >= 1, "eval_every", self.eval_every, "an integer >= 1")
         check(
@@ -96,6 +102,7 @@ _POINT = dict(
     batch_size=256,
     bc_steps=100,
     learning_rate=1e-3,
+    policy_ema=0.0,
     hidden=(64, 64, 64),
     normalise=True,
     eval_every=5,
@@ -109,6 +116,7 @@ _FETCH = dict(
     batch_size=1024,
     bc_steps=200,
     learning_rate=1e-3,
+    policy_ema=0.0,
     hidden=(256, 256, 256),
     normalise=True,
     eval_every=5,

@@ -20,8 +20,9 @@ from splid_jax.select import select
 
 @struct.dataclass
 class TrainState:
-    policy: PolicyState
+    policy: PolicyState  # the acting policy (explore, SELECT, eval, checkpoints' rollouts)
     opt_state: optax.OptState
+    online: dict | None  # the cloned parameters when they differ from the acting ones (policy_ema > 0)
     buffer: relabel_buffer.Buffer
     key: jax.Array
     iteration: jax.Array  # [] int32, completed iterations
@@ -60,6 +61,7 @@ class Trainer:
         return TrainState(
             policy=pstate,
             opt_state=self.optimiser.init(pstate.params),
+            online=None if cfg.policy_ema == 0 else jax.tree_util.tree_map(jnp.copy, pstate.params),
             buffer=relabel_buffer.init(cfg.buffer_size, env.obs_size, env.goal_size, env.action_size),
             key=k_run,
             iteration=jnp.int32(0),
@@ -72,8 +74,17 @@ class Trainer:
         cands = select(env, policy, ts.policy, traj, self.max_horizon, hyper.horizon, cfg.select, cfg.select_lanes)
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
         pstate = policy.update_normaliser(ts.policy, traj.states.obs, traj.achieved[:-1], ~traj.invalid[:-1])
-        pstate, opt_state, loss = bc_epoch(
-            policy, self.optimiser, pstate, ts.opt_state, buf, k_bc, cfg.bc_steps, cfg.batch_size
+        pstate, opt_state, online, loss = bc_epoch(
+            policy,
+            self.optimiser,
+            pstate,
+            ts.opt_state,
+            buf,
+            k_bc,
+            cfg.bc_steps,
+            cfg.batch_size,
+            online=ts.online,
+            ema=cfg.policy_ema,
         )
         metrics = {
             "select_pairs": jnp.sum(cands.valid, dtype=jnp.int32),
@@ -82,7 +93,9 @@ class Trainer:
             "bc_loss": loss,
             "explore_success": jnp.mean(jnp.any(traj.states.success, axis=0)),
         }
-        new = TrainState(policy=pstate, opt_state=opt_state, buffer=buf, key=key, iteration=ts.iteration + 1)
+        new = TrainState(
+            policy=pstate, opt_state=opt_state, online=online, buffer=buf, key=key, iteration=ts.iteration + 1
+        )
         return new, metrics
 
     def _chunk(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
@@ -97,7 +110,7 @@ class Trainer:
             bc_loss=per_iter["bc_loss"][-1],
             explore_success=jnp.mean(per_iter["explore_success"]),
             buffer_size=ts.buffer.size,
-            finite=params_finite(ts.policy.params) & jnp.all(jnp.isfinite(per_iter["bc_loss"])),
+            finite=params_finite((ts.policy.params, ts.online)) & jnp.all(jnp.isfinite(per_iter["bc_loss"])),
         )
         return ts.replace(key=key), metrics
 

@@ -24,16 +24,34 @@ def test_bc_steps_on_a_fixed_batch_lower_the_loss():
     before = bc_loss(pstate.params, policy, pstate, *batch)
     step = jax.jit(lambda p, o: bc_step(policy, opt, p, o, batch, 1.0))
     for _ in range(100):
-        pstate, opt_state, _ = step(pstate, opt_state)
+        pstate, opt_state, _, _ = step(pstate, opt_state)
     after = bc_loss(pstate.params, policy, pstate, *batch)
     assert float(after) < 0.2 * float(before)
+
+
+def test_polyak_acting_policy_follows_the_cloned_one_at_rate_one_minus_decay():
+    policy, pstate, batch = _setup()
+    opt = optax.adam(1e-2)
+    opt_state = opt.init(pstate.params)
+    online = jax.tree_util.tree_map(jnp.copy, pstate.params)
+    step = jax.jit(lambda p, o, on: bc_step(policy, opt, p, o, batch, 1.0, on, 0.9))
+    acting, _, cloned, _ = step(pstate, opt_state, online)
+    # one step: the acting parameters move a tenth of the way the cloned ones moved
+    moved = jax.tree_util.tree_map(lambda a, c, o: a - (o + 0.1 * (c - o)), acting.params, cloned, online)
+    assert max(float(jnp.max(jnp.abs(x))) for x in jax.tree_util.tree_leaves(moved)) < 1e-6
+    ps, os, on = pstate, opt_state, online
+    for _ in range(200):
+        ps, os, on, _ = step(ps, os, on)
+    before = float(bc_loss(pstate.params, policy, pstate, *batch))
+    assert float(bc_loss(on, policy, ps, *batch)) < 0.2 * before  # the cloned parameters learn
+    assert float(bc_loss(ps.params, policy, ps, *batch)) < 0.2 * before  # and the average acts as well
 
 
 def test_empty_buffer_leaves_parameters_unchanged():
     policy, pstate, _ = _setup()
     opt = optax.adam(1e-2)
     buf = relabel_buffer.init(16, 2, 2, 2)
-    new, _, _ = bc_epoch(policy, opt, pstate, opt.init(pstate.params), buf, jax.random.PRNGKey(0), 5, 8)
+    new, _, _, _ = bc_epoch(policy, opt, pstate, opt.init(pstate.params), buf, jax.random.PRNGKey(0), 5, 8)
     chex.assert_trees_all_equal(new.params, pstate.params)
 
 

@@ -51,6 +51,7 @@ def final_params(run_dir):
         (["--horizon", "0"], "horizon"),
         (["--horizon", "50"], "horizon"),
         (["--num-envs", "0"], "num_envs"),
+        (["--policy-ema", "1"], "policy_ema"),
         (["--env", "nope"], "env"),
         (["--iterations", "7", "--eval-every", "5"], "iterations"),
         (["--env-options", "success_radius"], "env_options"),
@@ -86,7 +87,7 @@ def test_help_documents_every_flag(capsys):
 @pytest.mark.slow
 def test_resume_after_kill_matches_an_uninterrupted_run(tmp_path):
     whole, killed = str(tmp_path / "whole"), str(tmp_path / "killed")
-    args = [*TINY, "--iterations", "60", "--quiet"]
+    args = [*TINY, "--iterations", "60", "--policy-ema", "0.9", "--quiet"]  # the averaged policy is state too
     reference = cli(*args, "--run-dir", whole)
     victim = cli(*args, "--run-dir", killed)
     deadline = time.time() + 240
