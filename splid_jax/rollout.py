@@ -16,7 +16,7 @@ import numpy as np
 from envs.base import InvalidConfig
 from splid_jax import checkpoint
 from splid_jax.cli import add_compile_cache_flag, use_compile_cache
-from splid_jax.config import TrainConfig
+from splid_jax.config import TrainConfig, saved_fields
 from splid_jax.train import make_env
 from splid_jax.trainer import Trainer
 
@@ -27,7 +27,7 @@ def load_policy(run_dir: str):
     if not os.path.isfile(path):
         raise InvalidConfig("run_dir", run_dir, "a run directory holding config.json")
     with open(path) as fh:
-        cfg = TrainConfig(**{**json.load(fh), "run_dir": run_dir})
+        cfg = TrainConfig(**{**saved_fields(json.load(fh)), "run_dir": run_dir})
     env = make_env(cfg.env, **cfg.env_overrides())
     trainer = Trainer(env, cfg)
     step, state, _ = checkpoint.restore(run_dir, trainer.init(jax.random.PRNGKey(0)))

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import dataclasses
 import io
 import json
 import os
@@ -22,7 +21,7 @@ import envs
 from envs.base import InvalidConfig
 from splid_jax import checkpoint, progress
 from splid_jax.cli import add_compile_cache_flag, add_config_flags, explicit_values, use_compile_cache
-from splid_jax.config import TASK_DEFAULTS, TrainConfig
+from splid_jax.config import TASK_DEFAULTS, TrainConfig, saved_fields
 from splid_jax.trainer import Trainer
 
 # Fields a resumed run must share with its checkpoint; the rest may change on resume.
@@ -188,9 +187,7 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
     if not os.path.isfile(path):
         raise InvalidConfig("resume", ns.resume, "a run directory holding config.json")
     with open(path) as fh:
-        saved = json.load(fh)
-    fields = {f.name for f in dataclasses.fields(TrainConfig)}
-    saved = {k: v for k, v in saved.items() if k in fields}
+        saved = saved_fields(json.load(fh))
     for k, v in given.items():
         if k not in _MAY_CHANGE_ON_RESUME and v != saved.get(k) and not (isinstance(v, tuple) and list(v) == saved[k]):
             raise InvalidConfig(k, v, f"{saved.get(k)!r} as in the run being resumed (only iterations may change)")
