@@ -92,3 +92,17 @@ def flag_invalid(state: State) -> State:
     leaves = [x for x in jax.tree_util.tree_leaves(state) if jnp.issubdtype(x.dtype, jnp.floating)]
     bad = jnp.any(jnp.stack([jnp.any(jnp.isnan(x)) for x in leaves]))
     return state.replace(invalid=state.invalid | bad)
+
+
+# XLA:CPU (jaxlib 0.10.2, 2-core machine, 2026-11-23) parks every thread and never returns when a
+# vmapped MJX step of about 1,000 envs or more runs inside a loop: 750 envs ran, 1,000 did not, with
+# or without multi-threaded Eigen or async dispatch. On the CPU the batch is therefore stepped in
+# slices of this many envs; each env's step is independent, so only the schedule changes.
+CPU_STEP_SLICE = 512
+
+
+def step_batch(env: GoalEnv, state: State, action: jax.Array) -> State:
+    """``env.step`` over a leading batch axis: one vmap, or on the CPU ``lax.map`` over slices."""
+    if jax.default_backend() != "cpu" or action.shape[0] <= CPU_STEP_SLICE:
+        return jax.vmap(env.step)(state, action)
+    return jax.lax.map(lambda sa: env.step(*sa), (state, action), batch_size=CPU_STEP_SLICE)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from envs.base import GoalEnv, State
+from envs.base import GoalEnv, State, step_batch
 from splid_jax.networks import Policy, PolicyState
 
 
@@ -14,7 +14,7 @@ def evaluate(env: GoalEnv, policy: Policy, pstate: PolicyState, key: jax.Array, 
     start = jax.vmap(env.reset)(jax.random.split(key, num_episodes))
 
     def one_step(state: State, _):
-        nxt = jax.vmap(env.step)(state, policy.act(pstate, state.obs, state.desired_goal))
+        nxt = step_batch(env, state, policy.act(pstate, state.obs, state.desired_goal))
         return nxt, (nxt.success & ~nxt.invalid, nxt.reward)
 
     final, (succ, rew) = jax.lax.scan(one_step, start, None, length=env.episode_length)

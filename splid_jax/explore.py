@@ -8,7 +8,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from envs.base import GoalEnv, State
+from envs.base import GoalEnv, State, step_batch
 from splid_jax.networks import Policy, PolicyState
 
 
@@ -31,7 +31,7 @@ def explore(
         mean = policy.mean(pstate, state.obs, state.desired_goal)
         noise = sigma * jax.random.normal(k, mean.shape)
         action = jnp.clip(mean + noise, -1.0, 1.0)
-        nxt = jax.vmap(env.step)(state, action)
+        nxt = step_batch(env, state, action)
         return nxt, (state, action, nxt.achieved_goal, nxt.invalid)
 
     _, (states, actions, ag_next, inv_next) = jax.lax.scan(

@@ -13,7 +13,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from envs.base import InvalidConfig
+from envs.base import InvalidConfig, step_batch
 from splid_jax import checkpoint
 from splid_jax.cli import add_compile_cache_flag, use_compile_cache
 from splid_jax.config import TrainConfig, saved_fields
@@ -38,7 +38,7 @@ def rollout(env, trainer, pstate, key, episodes: int):
     """Episodes of the deterministic policy: the states [T + 1, E] and per-step success [T, E]."""
 
     def one_step(s, _):
-        nxt = jax.vmap(env.step)(s, trainer.policy.act(pstate, s.obs, s.desired_goal))
+        nxt = step_batch(env, s, trainer.policy.act(pstate, s.obs, s.desired_goal))
         return nxt, nxt
 
     start = jax.vmap(env.reset)(jax.random.split(key, episodes))

@@ -18,7 +18,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from envs.base import GoalEnv, State
+from envs.base import GoalEnv, State, step_batch
 from splid_jax.explore import Trajectory
 from splid_jax.networks import Policy, PolicyState
 
@@ -105,7 +105,7 @@ def replay_queue(
     )
 
     def body(q: _Queue) -> _Queue:
-        s = jax.vmap(env.step)(q.state, policy.act(pstate, q.state.obs, q.state.desired_goal))
+        s = step_batch(env, q.state, policy.act(pstate, q.state.obs, q.state.desired_goal))
         steps = q.steps + 1
         hit = s.success & ~s.invalid
         done = q.active & (hit | (steps >= horizon_of[q.cand]))
