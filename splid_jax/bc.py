@@ -35,13 +35,11 @@ def bc_step(
     grads = jax.tree_util.tree_map(lambda g: g * weight, grads)
     updates, new_opt = optimiser.update(grads, opt_state, cloned)
     new_cloned = optax.apply_updates(cloned, updates)
-    keep = weight > 0
-    new_cloned = jax.tree_util.tree_map(lambda n, o: jnp.where(keep, n, o), new_cloned, cloned)
-    new_opt = jax.tree_util.tree_map(lambda n, o: jnp.where(keep, n, o), new_opt, opt_state)
+    unless_empty = lambda new, old: jax.tree_util.tree_map(lambda n, o: jnp.where(weight > 0, n, o), new, old)  # noqa: E731
+    new_cloned, new_opt = unless_empty(new_cloned, cloned), unless_empty(new_opt, opt_state)
     if online is None:
         return pstate.replace(params=new_cloned), new_opt, None, loss
-    acting = optax.incremental_update(new_cloned, pstate.params, 1.0 - ema)
-    acting = jax.tree_util.tree_map(lambda n, o: jnp.where(keep, n, o), acting, pstate.params)
+    acting = unless_empty(optax.incremental_update(new_cloned, pstate.params, 1.0 - ema), pstate.params)
     return pstate.replace(params=acting), new_opt, new_cloned, loss
 
 
