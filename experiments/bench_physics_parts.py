@@ -18,7 +18,6 @@ import argparse
 import contextlib
 import io
 import json
-import statistics
 import sys
 import time
 from pathlib import Path
@@ -31,7 +30,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 with contextlib.redirect_stdout(io.StringIO()):  # mujoco.mjx prints a note about warp on import
     from mujoco import mjx
 
+from bench_splid import timed as timed_calls  # noqa: E402
+
 import envs  # noqa: E402
+from envs.base import step_batch  # noqa: E402
 
 STAGES = {
     # the stages of mjx.step in the order it runs them (forward, then the integrator)
@@ -57,7 +59,7 @@ def sample_data(env, batch: int, steps: int, key):
         random = jax.random.uniform(k, (batch, env.action_size), minval=-1.0, maxval=1.0)
         mix = jnp.where((jnp.arange(batch) % 2 == 0)[:, None], towards, random[:, :3])
         action = random.at[:, :3].set(mix)
-        return jax.vmap(env.step)(s, action), None
+        return step_batch(env, s, action), None
 
     states, _ = jax.lax.scan(one, states, jax.random.split(jax.random.fold_in(key, 1), steps))
     return states.physics
@@ -77,16 +79,8 @@ def data_for(model, phys):
 
 def timed(fn, model, data, times: int, repeats: int) -> dict:
     prog = jax.jit(lambda d: jax.lax.fori_loop(0, times, lambda _, x: jax.vmap(lambda y: fn(model, y))(x), d))
-    t0 = time.perf_counter()
-    jax.block_until_ready(prog(data))
-    first = time.perf_counter() - t0
-    runs = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        jax.block_until_ready(prog(data))
-        runs.append(time.perf_counter() - t0)
-    med = statistics.median(runs)
-    return {"per_application_ms": 1e3 * med / times, "compile_s": first - med}
+    stats, _ = timed_calls(prog, data, repeats=repeats)
+    return {"per_application_ms": 1e3 * stats["median_s"] / times, "compile_s": stats["compile_s"]}
 
 
 def main(argv=None) -> int:
