@@ -33,6 +33,7 @@ with contextlib.redirect_stdout(io.StringIO()):  # mujoco.mjx prints a note abou
 from bench_splid import timed as timed_calls  # noqa: E402
 
 import envs  # noqa: E402
+from envs import small_cholesky  # noqa: E402
 from envs.base import step_batch  # noqa: E402
 
 STAGES = {
@@ -77,9 +78,15 @@ def data_for(model, phys):
     return jax.jit(jax.vmap(one))(phys)
 
 
-def timed(fn, model, data, times: int, repeats: int) -> dict:
-    prog = jax.jit(lambda d: jax.lax.fori_loop(0, times, lambda _, x: jax.vmap(lambda y: fn(model, y))(x), d))
-    stats, _ = timed_calls(prog, data, repeats=repeats)
+def timed(fn, model, data, times: int, repeats: int, unrolled: bool = True) -> dict:
+    """Per-application time of ``fn``; MJX's small Cholesky solves unrolled as the tasks run them
+    (``envs/small_cholesky.py``) unless ``unrolled`` is False."""
+
+    def prog(d):
+        with small_cholesky.unrolled_in_mjx(unrolled):
+            return jax.lax.fori_loop(0, times, lambda _, x: jax.vmap(lambda y: fn(model, y))(x), d)
+
+    stats, _ = timed_calls(jax.jit(prog), data, repeats=repeats)
     return {"per_application_ms": 1e3 * stats["median_s"] / times, "compile_s": stats["compile_s"]}
 
 
@@ -108,6 +115,7 @@ def main(argv=None) -> int:
     rows = []
     whole = {
         "mjx.step (one substep)": model,
+        "mjx.step, jax.scipy.linalg Cholesky": model,
         "mjx.step, contacts off (DisableBit.CONTACT)": model.replace(
             opt=model.opt.replace(disableflags=model.opt.disableflags | mjx.DisableBit.CONTACT)
         ),
@@ -119,7 +127,7 @@ def main(argv=None) -> int:
         ),
     }
     for name, m in whole.items():
-        r = timed(mjx.step, m, data_for(m, phys), a.repeat_stage, a.repeats)
+        r = timed(mjx.step, m, data_for(m, phys), a.repeat_stage, a.repeats, unrolled="linalg" not in name)
         rows.append({"part": name, **r})
         print(f"{name:90s} {r['per_application_ms']:8.3f} ms  (compile {r['compile_s']:.1f} s)")
     for name, fn in STAGES.items():

@@ -18,6 +18,8 @@ Defaults: 10 substeps of 4 ms (the reference takes 20 of 2 ms), Newton with 4 it
 line-search iterations (Slide: 10 iterations; with 4 a resting low-friction puck crept up to 10 cm
 in 50 steps in float32 MJX while MuJoCo C held it still; 10 showed no measurable cost at batch 64
 on CPU). Both are task fields (``timestep``, ``substeps``, ``iterations``, ``ls_iterations``).
+MJX's small dense Cholesky solves run unrolled (``envs/small_cholesky.py``; ``cholesky="library"``
+keeps ``jax.scipy.linalg``'s, 1.40x slower per GPU step and equal to float rounding).
 Measured on CPU on these models, per timing 20 x 2 / 10 x 4 / 4 x 10 ms:
 
 - a crude scripted push, MuJoCo C, 200 episodes: success 0.76-0.83 (10 or 4 iterations) / 0.72 /
@@ -49,12 +51,14 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
+from envs import small_cholesky
 from envs.base import GoalEnv, State, check, flag_invalid
 from envs.fetch import models
 
 MIN_OBJECT_DISTANCE = 0.1  # the object starts at least this far from the gripper in xy
 _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4) ** 64 ~ 2e-7
 GOAL_LIFT_MAX = 0.45
+CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
 
 
 @struct.dataclass
@@ -106,6 +110,7 @@ class _FetchTask(GoalEnv):
     ls_iterations: int = 4
     table: str = "plane"  # the table's collision shape: its top face as a plane, or the reference's box
     finger: str = "box"  # the closed finger block's collision shape (Push: box or capsule, see models.py)
+    cholesky: str = "unrolled"  # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -128,6 +133,7 @@ class _FetchTask(GoalEnv):
         check(self.table in tables, f"{n}.table", self.table, "one of " + ", ".join(tables))
         fingers = models.fingers_for(n)
         check(self.finger in fingers, f"{n}.finger", self.finger, "one of " + ", ".join(fingers))
+        check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
         check(
             isinstance(self.max_episode_steps, int) and self.max_episode_steps >= 1,
             f"{n}.max_episode_steps",
@@ -301,7 +307,8 @@ class _FetchTask(GoalEnv):
         data = mjx.make_data(model).replace(
             qpos=phys.qpos, qvel=phys.qvel, ctrl=ctrl, time=phys.time, qacc_warmstart=phys.qacc_warmstart
         )
-        data = jax.lax.fori_loop(0, self.substeps, lambda _, d: mjx.step(model, d), data)
+        with small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"):
+            data = jax.lax.fori_loop(0, self.substeps, lambda _, d: mjx.step(model, d), data)
         return Physics(
             qpos=data.qpos, qvel=data.qvel, ctrl=data.ctrl, time=data.time, qacc_warmstart=data.qacc_warmstart
         )

@@ -144,6 +144,7 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("reach", "timestep", 0.0),
         ("push", "iterations", 0),
         ("reach", "max_episode_steps", 0),
+        ("push", "cholesky", "lapack"),
     ],
 )
 def test_bad_overrides_fail_naming_the_field(name, field, value):

@@ -1,0 +1,81 @@
+"""The unrolled Cholesky that MJX steps use: equal to jax.scipy.linalg's to float rounding, in
+effect only inside its block, and live in a Push step (no library Cholesky left in its program)."""
+
+from __future__ import annotations
+
+import jax
+import jax.extend.core
+import jax.numpy as jnp
+import jax.scipy.linalg as jsl
+import numpy as np
+import pytest
+
+import envs
+from envs import small_cholesky
+
+
+def _spd(n, seed):
+    m = np.random.default_rng(seed).normal(size=(n, n + 3))
+    return jnp.asarray(m @ m.T / (n + 3) + 0.1 * np.eye(n), jnp.float32)
+
+
+@pytest.mark.parametrize("n", [1, 3, 9, 11])
+@pytest.mark.parametrize("lower", [False, True])
+def test_factor_and_solve_match_the_library(n, lower):
+    a = _spd(n, n)
+    b = jnp.asarray(np.random.default_rng(100 + n).normal(size=(n,)), jnp.float32)
+    bm = jnp.stack([b, 2.0 * b + 1.0], axis=1)
+    ours = small_cholesky.cho_factor(a, lower=lower)
+    ref = jsl.cho_factor(a, lower=lower)
+    assert ours[1] == lower
+    tri = jnp.tril(ref[0]) if lower else jnp.triu(ref[0])  # the library leaves junk in the other half
+    np.testing.assert_allclose(ours[0], tri, rtol=2e-5, atol=2e-6)
+    np.testing.assert_allclose(small_cholesky.cho_solve(ours, b), jsl.cho_solve(ref, b), rtol=1e-4, atol=1e-5)
+    np.testing.assert_allclose(small_cholesky.cho_solve(ours, bm), jsl.cho_solve(ref, bm), rtol=1e-4, atol=1e-5)
+    np.testing.assert_allclose(a @ small_cholesky.cho_solve(ours, b), b, rtol=1e-3, atol=1e-4)
+
+
+def test_large_or_batched_matrices_go_to_the_library():
+    a = _spd(small_cholesky.MAX_UNROLLED + 1, 0)
+    np.testing.assert_array_equal(small_cholesky.cho_factor(a)[0], jsl.cho_factor(a)[0])
+    batch = jnp.stack([_spd(3, 1), _spd(3, 2)])
+    np.testing.assert_array_equal(small_cholesky.cho_factor(batch)[0], jsl.cho_factor(batch)[0])
+
+
+def test_substitution_holds_only_inside_the_block():
+    library = (jsl.cho_factor, jsl.cho_solve)
+    with small_cholesky.unrolled_in_mjx():
+        assert (jsl.cho_factor, jsl.cho_solve) == (small_cholesky.cho_factor, small_cholesky.cho_solve)
+        with small_cholesky.unrolled_in_mjx(False):
+            assert jsl.cho_factor is small_cholesky.cho_factor
+    assert (jsl.cho_factor, jsl.cho_solve) == library
+    with pytest.raises(RuntimeError), small_cholesky.unrolled_in_mjx():
+        raise RuntimeError("a failed trace")
+    assert (jsl.cho_factor, jsl.cho_solve) == library
+
+
+def _primitives(jaxpr) -> set[str]:
+    names = set()
+    for eqn in jaxpr.eqns:
+        names.add(eqn.primitive.name)
+        for sub in jax.extend.core.jaxprs_in_params(eqn.params):
+            names |= _primitives(sub)
+    return names
+
+
+def test_push_step_has_no_library_cholesky_and_steps_alike():
+    fast, library = envs.make("push"), envs.make("push", cholesky="library")
+    state = jax.vmap(fast.reset)(jax.random.split(jax.random.PRNGKey(0), 2))
+    action = jnp.array([[0.5, -0.3, -1.0, 0.0], [-1.0, 1.0, 0.2, 0.0]])
+    step = jax.vmap(fast.step)
+    prims_fast = _primitives(jax.make_jaxpr(step)(state, action).jaxpr)
+    prims_lib = _primitives(jax.make_jaxpr(jax.vmap(library.step))(state, action).jaxpr)
+    assert "cholesky" in prims_lib and "cholesky" not in prims_fast
+    assert "triangular_solve" not in prims_fast
+
+    def run(env):
+        return jax.jit(lambda s: jax.lax.fori_loop(0, 3, lambda _, x: jax.vmap(env.step)(x, action), s))(state)
+
+    a, b = run(fast), run(library)
+    np.testing.assert_allclose(a.physics.qpos, b.physics.qpos, atol=1e-4)
+    np.testing.assert_allclose(a.physics.qvel, b.physics.qvel, atol=1e-2)
