@@ -4,9 +4,9 @@ Why: an MJX step of a Fetch-style task factors and solves a dense nv x nv system
 substep (the mass matrix, the implicit-damping Euler update, and the Newton solver's Hessian at its
 start and at each iteration), each through ``jax.scipy.linalg.cho_factor`` / ``cho_solve``. Under
 ``vmap`` on a GPU those become batched cuSOLVER / cuBLAS calls that are slow for such tiny matrices:
-65,536 9 x 9 factor-and-solves took 0.38 ms on an H100, against 0.044 ms for the same arithmetic
-unrolled here, which XLA fuses into one element-wise kernel; a whole Push substep ran 1.40x faster
-(7.61 -> 5.43 ms, ``experiments/bench_env.py``, 2026-11-23). It is the same algorithm (the
+65,536 9 x 9 factor-and-solves took 0.388 ms on an H200, against 0.053 ms for the same arithmetic
+unrolled here, which XLA fuses into element-wise kernels (``experiments/bench_cholesky.py``). Push then runs 1.65x the control steps
+per second on an H200 (``BENCHMARKS.md`` section 1, 2026-11-23). It is the same algorithm (the
 Cholesky-Banachiewicz order), so results agree with the library's to float rounding.
 
 ``unrolled_in_mjx()`` swaps the two functions in for the duration of a trace: MJX looks them up on

@@ -19,7 +19,7 @@ line-search iterations (Slide: 10 iterations; with 4 a resting low-friction puck
 in 50 steps in float32 MJX while MuJoCo C held it still; 10 showed no measurable cost at batch 64
 on CPU). Both are task fields (``timestep``, ``substeps``, ``iterations``, ``ls_iterations``).
 MJX's small dense Cholesky solves run unrolled (``envs/small_cholesky.py``; ``cholesky="library"``
-keeps ``jax.scipy.linalg``'s, 1.40x slower per GPU step and equal to float rounding).
+keeps ``jax.scipy.linalg``'s: equal to float rounding, Push 1.65x slower on an H200).
 Measured on CPU on these models, per timing 20 x 2 / 10 x 4 / 4 x 10 ms:
 
 - a crude scripted push, MuJoCo C, 200 episodes: success 0.76-0.83 (10 or 4 iterations) / 0.72 /
