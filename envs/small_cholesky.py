@@ -5,9 +5,10 @@ substep (the mass matrix, the implicit-damping Euler update, and the Newton solv
 start and at each iteration), each through ``jax.scipy.linalg.cho_factor`` / ``cho_solve``. Under
 ``vmap`` on a GPU those become batched cuSOLVER / cuBLAS calls that are slow for such tiny matrices:
 65,536 9 x 9 factor-and-solves took 0.388 ms on an H200, against 0.053 ms for the same arithmetic
-unrolled here, which XLA fuses into element-wise kernels (``experiments/bench_cholesky.py``). Push then runs 1.65x the control steps
-per second on an H200 (``BENCHMARKS.md`` section 1, 2026-11-23). It is the same algorithm (the
-Cholesky-Banachiewicz order), so results agree with the library's to float rounding.
+unrolled here, which XLA fuses into element-wise kernels (``experiments/bench_cholesky.py``). Push
+then runs 1.65x the control steps per second on an H200 (``BENCHMARKS.md`` section 1, 2026-11-23).
+It is the same algorithm (the Cholesky-Banachiewicz order), so results agree with the library's to
+float rounding.
 
 ``unrolled_in_mjx()`` swaps the two functions in for the duration of a trace: MJX looks them up on
 ``jax.scipy.linalg`` when its code runs, which under ``jit`` is trace time only, so the compiled
