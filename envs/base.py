@@ -101,8 +101,17 @@ def flag_invalid(state: State) -> State:
 CPU_STEP_SLICE = 512
 
 
+def _placed_on_cpu() -> bool:
+    """Whether the computation being traced goes to a CPU: the ``jax.default_device`` in force (a CPU
+    peer on a GPU host sets it), else the default backend."""
+    dev = jax.config.jax_default_device
+    if dev is None:
+        return jax.default_backend() == "cpu"
+    return (dev if isinstance(dev, str) else dev.platform) == "cpu"
+
+
 def step_batch(env: GoalEnv, state: State, action: jax.Array) -> State:
     """``env.step`` over a leading batch axis: one vmap, or on the CPU ``lax.map`` over slices."""
-    if jax.default_backend() != "cpu" or action.shape[0] <= CPU_STEP_SLICE:
+    if action.shape[0] <= CPU_STEP_SLICE or not _placed_on_cpu():
         return jax.vmap(env.step)(state, action)
     return jax.lax.map(lambda sa: env.step(*sa), (state, action), batch_size=CPU_STEP_SLICE)
