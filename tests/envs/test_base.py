@@ -6,7 +6,6 @@ import textwrap
 
 import chex
 import jax
-import jax.extend.core
 
 import envs
 from envs.base import CPU_STEP_SLICE, step_batch
@@ -23,16 +22,7 @@ def test_slices_give_what_one_vmap_gives():
     chex.assert_trees_all_close(sliced, whole, rtol=1e-6, atol=1e-6)
 
 
-def _primitives(jaxpr) -> set[str]:
-    names = set()
-    for eqn in jaxpr.eqns:
-        names.add(eqn.primitive.name)
-        for sub in jax.extend.core.jaxprs_in_params(eqn.params):
-            names |= _primitives(sub)
-    return names
-
-
-def test_a_cpu_computation_on_an_accelerator_host_is_sliced(monkeypatch):
+def test_a_cpu_computation_on_an_accelerator_host_is_sliced(monkeypatch, primitives):
     # a CPU peer on a GPU host: the default backend is the GPU, the default device the CPU
     env = envs.make("point")
     n = CPU_STEP_SLICE + 1
@@ -40,7 +30,7 @@ def test_a_cpu_computation_on_an_accelerator_host_is_sliced(monkeypatch):
     action = jax.numpy.zeros((n, env.action_size))
 
     def prims():
-        return _primitives(jax.make_jaxpr(lambda s, a: step_batch(env, s, a))(state, action).jaxpr)
+        return primitives(lambda s, a: step_batch(env, s, a), state, action)
 
     monkeypatch.setattr(jax, "default_backend", lambda: "gpu")
     assert "scan" not in prims()  # on the accelerator: one vmap
