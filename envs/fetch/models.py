@@ -141,22 +141,34 @@ def mjcf(
     ls_iterations: int = 4,
     table: str = "plane",
     finger: str = "box",
+    *,
+    gripper_mass: float | None = None,
+    drive_omega: float = DRIVE_OMEGA,
+    drive_damping_ratio: float = 1.0,
 ) -> str:
     """The MJCF text of task ``kind`` (one of ``KINDS``); ``table`` is the table's collision shape
-    (``tables_for(kind)``), ``finger`` the closed finger block's (``fingers_for(kind)``)."""
+    (``tables_for(kind)``), ``finger`` the closed finger block's (``fingers_for(kind)``).
+
+    ``gripper_mass`` (default: the task's), ``drive_omega`` and ``drive_damping_ratio`` change the xyz
+    drive (kp = m w^2, damping 2 z m w) for sensitivity studies (``experiments/parity/slide_strike.py``);
+    the tasks use the defaults."""
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
     if table not in tables_for(kind):
         raise ValueError(f"table {table!r} for {kind}: one of {tables_for(kind)}")
     if finger not in fingers_for(kind):
         raise ValueError(f"finger {finger!r} for {kind}: one of {fingers_for(kind)}")
+    for name, value in (("gripper_mass", gripper_mass), ("drive_omega", drive_omega),
+                        ("drive_damping_ratio", drive_damping_ratio)):
+        if value is not None and not value > 0:
+            raise ValueError(f"{name} must be > 0, got {value}")
     (tx, ty, tz), (hx, hy, hz), (gx, gy, gz) = _SCENES[kind]
     has_object = kind != "reach"
     free_fingers = kind == "pick_and_place"
     slide = kind == "slide"
-    mass = SLIDE_GRIPPER_MASS if slide else GRIPPER_MASS
-    w = DRIVE_OMEGA
-    kp, kv = mass * w * w, 2.0 * mass * w
+    mass = gripper_mass if gripper_mass is not None else SLIDE_GRIPPER_MASS if slide else GRIPPER_MASS
+    w = drive_omega
+    kp, kv = mass * w * w, 2.0 * drive_damping_ratio * mass * w
     obj_half = (OBJECT_HALF, OBJECT_HALF, PUCK_HALF_HEIGHT if slide else OBJECT_HALF)
     rest_z = TABLE_TOP + obj_half[2]
     ox, oy = gx + 0.1, gy + 0.1  # any spot on the table; reset moves it

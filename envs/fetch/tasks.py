@@ -111,6 +111,8 @@ class _FetchTask(GoalEnv):
     table: str = "plane"  # the table's collision shape: its top face as a plane, or the reference's box
     finger: str = "box"  # the closed finger block's collision shape (Push: box or capsule, see models.py)
     cholesky: str = "unrolled"  # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
+    drive_omega: float = models.DRIVE_OMEGA  # rad/s: natural frequency of the gripper's xyz drive
+    drive_damping_ratio: float = 1.0  # of the same drive (models.mjcf)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -134,6 +136,8 @@ class _FetchTask(GoalEnv):
         fingers = models.fingers_for(n)
         check(self.finger in fingers, f"{n}.finger", self.finger, "one of " + ", ".join(fingers))
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
+        check(10 <= self.drive_omega <= 200, f"{n}.drive_omega", self.drive_omega, "in [10, 200] rad/s")
+        check(0.5 <= self.drive_damping_ratio <= 3, f"{n}.drive_damping_ratio", self.drive_damping_ratio, "in [0.5, 3]")
         check(
             isinstance(self.max_episode_steps, int) and self.max_episode_steps >= 1,
             f"{n}.max_episode_steps",
@@ -177,6 +181,8 @@ class _FetchTask(GoalEnv):
             ls_iterations=int(self.ls_iterations),
             table=str(self.table),
             finger=str(self.finger),
+            drive_omega=float(self.drive_omega),
+            drive_damping_ratio=float(self.drive_damping_ratio),
         )
 
     @property

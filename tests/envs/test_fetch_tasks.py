@@ -145,6 +145,8 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("push", "iterations", 0),
         ("reach", "max_episode_steps", 0),
         ("push", "cholesky", "lapack"),
+        ("slide", "drive_omega", 0.0),
+        ("push", "drive_damping_ratio", 10.0),
     ],
 )
 def test_bad_overrides_fail_naming_the_field(name, field, value):
@@ -213,6 +215,31 @@ def test_slide_puck_is_a_cylinder_on_a_plane_struck_at_the_controller_corner():
     tips = [m.geom(f"tip_{i}") for i in range(4)]
     corners = sorted((abs(float(t.pos[0])), abs(float(t.pos[1]))) for t in tips)
     assert corners == [tuple(scripted.FINGER_HALF_XY)] * 4
+
+
+def _grip_speed_after_jump(xml, ms=8.0, jump=0.045):
+    """Grip x speed ``ms`` after the drive's target jumps ``jump`` ahead of a gripper at rest (MuJoCo C)."""
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    g = m.joint("grip_x").qposadr[0]
+    d.ctrl[0:3] = d.qpos[g : g + 3] + [jump, 0.0, 0.0]
+    for _ in range(int(round(ms / 1000 / m.opt.timestep))):
+        mujoco.mj_step(m, d)
+    return float(d.qvel[g])
+
+
+def test_drive_options_set_how_fast_the_gripper_follows_and_reject_nonpositive_values():
+    default = models.mjcf("slide", 0.004, 10, 4)
+    assert models.mjcf("slide", 0.004, 10, 4, gripper_mass=13.0, drive_omega=50.0, drive_damping_ratio=1.0) == default
+    base = _grip_speed_after_jump(default)
+    assert _grip_speed_after_jump(models.mjcf("slide", 0.004, 10, 4, drive_omega=70.0)) > 1.2 * base
+    assert _grip_speed_after_jump(models.mjcf("slide", 0.004, 10, 4, drive_damping_ratio=1.5)) < 0.9 * base
+    # gains scale with the mass (the drawn fingers' few grams aside), so a heavier gripper follows alike
+    np.testing.assert_allclose(_grip_speed_after_jump(models.mjcf("slide", 0.004, 10, 4, gripper_mass=20.0)), base,
+                               rtol=1e-3)
+    for field in ("gripper_mass", "drive_omega", "drive_damping_ratio"):
+        with pytest.raises(ValueError, match=field):
+            models.mjcf("slide", **{field: 0.0})
 
 
 # ---- physics: one compiled program per task --------------------------------------------------------
