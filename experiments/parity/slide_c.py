@@ -48,8 +48,10 @@ def run(
     controller=None,
     steps: int = 50,
     ep_starts=None,
+    on_substep=None,
 ):
-    """Run the slide controller on ``xml``; returns a dict of per-episode arrays."""
+    """Run the slide controller on ``xml``; returns a dict of per-episode arrays. ``on_substep(i, m, d)``,
+    if given, is called after every MuJoCo step of episode ``i``."""
     import jax
 
     from envs.fetch import models, scripted
@@ -101,6 +103,8 @@ def run(
             d.ctrl[0:3] = target
             for _ in range(substeps):
                 mujoco.mj_step(m, d)
+                if on_substep is not None:
+                    on_substep(i, m, d)
             if not np.isfinite(d.qpos).all() or d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
                 bad[i] = True
                 continue

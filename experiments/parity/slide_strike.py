@@ -1,0 +1,374 @@
+"""Slide's strike, measured on both sides: why ours and the reference differ at the final step.
+
+The scripted slide (``envs/fetch/scripted.py``) closes in on the puck slowly, then pushes at the
+launch speed from which friction alone stops the puck on the goal; the puck leaves the fingers faster
+than the gripper moves and glides. A puck that stops short is pushed again, one that glides past the
+goal cannot be pulled back. So final-step success hinges on the mean launch speed against the wanted
+one. Per episode this records, at MuJoCo-step resolution:
+
+- ``want``: the wanted launch speed (``scripted.launch_velocity`` of the start-to-goal displacement);
+- ``v_grip``: the grip site's speed along the launch line at the first finger-puck contact;
+- ``v_puck``: the puck's peak speed along that line; ``strikes``: finger-puck contacts begun;
+- ``along`` / ``across``: where the puck ends, along the start-to-goal line (past the goal > 0) and off it.
+
+It also records the free-space drive response: the grip site's speed every 4 ms after the gripper
+target jumps 4.5 cm ahead of a gripper that was closing in at 0.2 m/s (the puck moved out of reach).
+
+    # the reference (its own environment, see README.md)
+    experiments/parity/.venv-ref/bin/python experiments/parity/slide_strike.py --side reference \\
+        --episodes 200 --out experiments/parity/results/strike_reference.json
+    # ours: our Slide MJCF, reset, control step and controller in MuJoCo C (``slide_c.py``)
+    python experiments/parity/slide_strike.py --side ours --episodes 200 \
+        --out experiments/parity/results/strike_ours.json
+    # ours under other drives and gripper masses (each a model option of ``envs.fetch.models.mjcf``)
+    python experiments/parity/slide_strike.py --side ours --grid --out experiments/parity/results/strike_grid.json
+    # side by side, as markdown
+    python experiments/parity/slide_strike.py --summary experiments/parity/results/strike_reference.json \\
+        experiments/parity/results/strike_ours.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import itertools
+import json
+import platform
+import sys
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+sys.path.insert(0, str(HERE))
+
+DECEL = 0.1 * 9.81  # the puck-table friction's deceleration, as the controller assumes
+RESPONSE_ACTIONS = [(0.16, 0.0, 0.0)] * 5 + [(0.9, 0.0, 0.0)] * 3  # close in at 8 mm / step, then jump 4.5 cm
+RESPONSE_FROM_STEP = 5  # the jump
+GRID_DRIVES = list(itertools.product((45.0, 50.0, 52.5, 55.0, 57.5, 60.0), (0.9, 1.0, 1.05, 1.1, 1.15, 1.2, 1.25)))
+GRID_MASSES = (10.0, 13.0, 16.0, 20.0)
+
+
+class Recorder:
+    """Collects one episode's strike from MuJoCo steps: first finger-puck contact, peak puck speed."""
+
+    def __init__(self, m, fingers, puck, grip_site, puck_dof, direction):
+        self.fingers, self.puck, self.site, self.dof = set(fingers), puck, grip_site, puck_dof
+        self.u = np.asarray(direction, float)
+        self.v_grip = float("nan")
+        self.v_puck = 0.0
+        self.strikes = 0
+        self._touching = False
+        self._vel = np.zeros(6)
+
+    def __call__(self, m, d):
+        touching = any(
+            (c.geom1 == self.puck and c.geom2 in self.fingers) or (c.geom2 == self.puck and c.geom1 in self.fingers)
+            for c in d.contact[: d.ncon]
+        )
+        if touching and not self._touching:
+            if self.strikes == 0:
+                mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_SITE, self.site, self._vel, 0)
+                self.v_grip = float(self._vel[3:5] @ self.u)
+            self.strikes += 1
+        self._touching = touching
+        self.v_puck = max(self.v_puck, float(d.qvel[self.dof : self.dof + 2] @ self.u))
+
+
+def _launch(scripted, start_xy, goal_xy):
+    v = np.asarray(scripted.launch_velocity(np.asarray(goal_xy - start_xy, np.float32)[None], DECEL))[0]
+    return float(np.linalg.norm(v)), v / max(float(np.linalg.norm(v)), 1e-9)
+
+
+def _landing(start_xy, goal_xy, final_xy):
+    d = goal_xy - start_xy
+    n = float(np.linalg.norm(d))
+    disp = final_xy - start_xy
+    return float(disp @ d / n - n), float(abs(disp[0] * d[1] - disp[1] * d[0]) / n)
+
+
+def run_reference(episodes: int, seed: int) -> dict:
+    """FetchSlide-v4 (gymnasium-robotics, MuJoCo C) with the scripted slide; its own steps, hooked."""
+    import jax
+    import run_reference as rr
+
+    scripted = rr.load_scripted()
+    policy = jax.jit(scripted.slide)
+    env = rr.make_env("FetchSlide-v4")
+    u_env = env.unwrapped
+    m, d = u_env.model, u_env.data
+    fingers = [m.geom(f"robot0:{s}_gripper_finger_link").id for s in ("l", "r")]
+    puck, site = m.geom("object0").id, m.site("robot0:grip").id
+    dof = int(m.joint("object0:joint").dofadr[0])
+    records = []
+    for ep in range(episodes):
+        obs, _ = env.reset(seed=seed + ep)
+        start, goal = obs["achieved_goal"][:2].copy(), obs["desired_goal"][:2].copy()
+        want, u = _launch(scripted, start, goal)
+        rec = Recorder(m, fingers, puck, site, dof, u)
+
+        def substeps(_action, rec=rec):
+            for _ in range(u_env.n_substeps):
+                mujoco.mj_step(m, d)
+                rec(m, d)
+
+        u_env._mujoco_step = substeps  # the env's own step, one MuJoCo step at a time
+        any_success = False
+        for _ in range(env.spec.max_episode_steps):
+            obs, _, _, _, info = env.step(np.asarray(policy(obs["observation"], obs["desired_goal"]), float))
+            any_success |= bool(info["is_success"])
+        along, across = _landing(start, goal, obs["achieved_goal"][:2])
+        records.append(_record(any_success, bool(info["is_success"]), want, rec, along, across))
+
+    # Free-space response: the puck far out of reach, the same action sequence.
+    env.reset(seed=seed)
+    q = int(m.joint("object0:joint").qposadr[0])
+    d.qpos[q : q + 2] = [1.6, 1.1]
+    mujoco.mj_forward(m, d)
+    speeds = []
+
+    every = round(0.004 / m.opt.timestep)
+    jac = np.zeros((3, m.nv))
+
+    def sample(_action):  # the site's speed from the velocities after the step, as qvel gives ours
+        for k in range(u_env.n_substeps):
+            mujoco.mj_step(m, d)
+            if (k + 1) % every == 0:
+                mujoco.mj_jacSite(m, d, jac, None, site)
+                speeds.append(float(jac[0] @ d.qvel))
+
+    u_env._mujoco_step = sample
+    for a in RESPONSE_ACTIONS:
+        env.step(np.array([*a, 0.0]))
+    import gymnasium_robotics
+
+    return _result("reference", records, speeds, {"gymnasium_robotics": gymnasium_robotics.__version__})
+
+
+def run_ours(episodes: int, seed: int, **model_options) -> dict:
+    """Our Slide MJCF in MuJoCo C through ``slide_c.run`` (our reset, control step and controller)."""
+    import slide_c
+
+    sys.path.insert(0, str(ROOT))
+    from envs.fetch import models, scripted
+
+    xml = models.mjcf("slide", 0.004, 10, 4, **model_options)
+    m = mujoco.MjModel.from_xml_string(xml)
+    fingers = [m.geom(f"tip_{i}").id for i in range(4)]
+    puck, site, dof = m.geom("object").id, m.site("grip").id, int(m.joint("object").dofadr[0])
+    obj_xy, goal_xy = slide_c.starts(episodes, seed)
+    recs = []
+    for i in range(episodes):
+        _, u = _launch(scripted, obj_xy[i], goal_xy[i])
+        recs.append(Recorder(m, fingers, puck, site, dof, u))
+    r = slide_c.run(xml, 0.004, 10, episodes, seed, ep_starts=(obj_xy, goal_xy),
+                    on_substep=lambda i, m_, d_: recs[i](m_, d_))
+    records = []
+    for i, rec in enumerate(recs):
+        want, _ = _launch(scripted, obj_xy[i], goal_xy[i])
+        along, across = _landing(obj_xy[i], goal_xy[i], r["final"][i, :2])
+        records.append(_record(bool(r["succ"][:, i].any()), bool(r["succ"][-1, i]), want, rec, along, across))
+
+    d = mujoco.MjData(m)
+    g, q = int(m.joint("grip_x").qposadr[0]), int(m.joint("object").qposadr[0])
+    d.qpos[q : q + 3] = [0.6, 0.35, 0.42]
+    mujoco.mj_forward(m, d)
+    speeds = []
+    for a in RESPONSE_ACTIONS:
+        d.ctrl[0:3] = d.qpos[g : g + 3] + 0.05 * np.asarray(a)
+        for _ in range(10):
+            mujoco.mj_step(m, d)
+            speeds.append(float(d.qvel[g]))
+    return _result("ours", records, speeds, {"mujoco": mujoco.__version__, "model_options": model_options})
+
+
+def _record(any_success, final_success, want, rec, along, across):
+    return {"success_any": any_success, "success_final": final_success, "want": want, "v_grip": rec.v_grip,
+            "v_puck": rec.v_puck, "strikes": rec.strikes, "along": along, "across": across}
+
+
+def _result(side, records, speeds, versions):
+    per_step = 10  # 4 ms samples per 0.04 s control step
+    return {
+        "side": side,
+        "date": datetime.date.today().isoformat(),
+        "machine": f"{platform.machine()}, {platform.node()}",
+        "versions": versions,
+        "command": " ".join(sys.argv),
+        "episodes": records,
+        "response_ms": [4 * (k + 1) for k in range(3 * per_step)],
+        "response_speed": speeds[RESPONSE_FROM_STEP * per_step :],
+    }
+
+
+def stats(result: dict) -> dict:
+    """Summary figures of one side's run."""
+    eps = result["episodes"]
+    f = lambda k: np.array([e[k] for e in eps], float)  # noqa: E731
+    want, vg, vp, along = f("want"), f("v_grip"), f("v_puck"), f("along")
+    struck = np.isfinite(vg) & (vg > 0.05)
+    return {
+        "episodes": len(eps),
+        "any": 100 * f("success_any").mean(),
+        "final": 100 * f("success_final").mean(),
+        "grip_over_want": (np.mean(vg[struck] / want[struck]), np.std(vg[struck] / want[struck])),
+        "launch_over_grip": (np.mean(vp[struck] / vg[struck]), np.std(vp[struck] / vg[struck])),
+        "launch_over_want": (np.mean(vp / want), np.std(vp / want)),
+        "along": (np.median(along), *np.percentile(along, [5, 95])),
+        "long": 100 * np.mean(along > 0.05),
+        "short": 100 * np.mean(along < -0.05),
+        "strikes": np.mean(f("strikes")),
+    }
+
+
+def response_rms(ours: dict, reference: dict) -> float:
+    """RMS difference (m/s) of the free-space responses, over the 120 ms after the target jump."""
+    a, b = np.asarray(ours["response_speed"]), np.asarray(reference["response_speed"])
+    n = min(len(a), len(b))
+    return float(np.sqrt(np.mean((a[:n] - b[:n]) ** 2)))
+
+
+def identify(runs: list[dict], reference_launch: float) -> dict:
+    """The drive chosen before looking at success: among the drives whose free-space response is at least
+    as close to the reference's as the default drive's, the one whose mean launch speed is closest to the
+    reference's."""
+    drives = [r for r in runs if "gripper_mass" not in r["options"]]
+    default = next(r for r in drives if r["options"] == {"drive_omega": 50.0, "drive_damping_ratio": 1.0})
+    ok = [r for r in drives if r["response_rms"] <= default["response_rms"] + 1e-12]
+    return min(ok, key=lambda r: abs(r["launch_over_want"] - reference_launch))
+
+
+def _pm(mean_std) -> str:
+    return "{:.3f} ± {:.3f}".format(*mean_std)
+
+
+def summary(results: list[dict]) -> str:
+    rows = [("episodes", lambda s: f"{s['episodes']}"),
+            ("success any / final (%)", lambda s: f"{s['any']:.1f} / {s['final']:.1f}"),
+            ("grip speed at first contact / wanted launch", lambda s: _pm(s["grip_over_want"])),
+            ("peak puck speed / grip speed at contact", lambda s: _pm(s["launch_over_grip"])),
+            ("peak puck speed / wanted launch", lambda s: _pm(s["launch_over_want"])),
+            ("end along the line, m: median [p5, p95]", lambda s: "{:+.3f} [{:+.3f}, {:+.3f}]".format(*s["along"])),
+            ("ended > 5 cm past / short of the goal (%)", lambda s: f"{s['long']:.1f} / {s['short']:.1f}"),
+            ("finger-puck contacts begun per episode", lambda s: f"{s['strikes']:.2f}")]
+    ss = [stats(r) for r in results]
+    out = ["| | " + " | ".join(r["side"] for r in results) + " |", "|---|" + "---:|" * len(results)]
+    out += [f"| {name} | " + " | ".join(fmt(s) for s in ss) + " |" for name, fmt in rows]
+    out += ["", "Free-space grip speed (m/s) after the target jump, every 4 ms:", "",
+            "| ms | " + " | ".join(r["side"] for r in results) + " |", "|---:|" + "---:|" * len(results)]
+    for k, ms in enumerate(results[0]["response_ms"][:12]):
+        out.append(f"| {ms} | " + " | ".join(f"{r['response_speed'][k]:.3f}" for r in results) + " |")
+    return "\n".join(out)
+
+
+def grid_table(grid: dict) -> str:
+    out = ["| drive w (rad/s) | damping ratio | gripper kg | any (%) | final (%) | > 5 cm past (%) | > 5 cm short (%) "
+           "| peak puck speed / wanted | free-space RMS vs reference (m/s) |",
+           "|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in grid["runs"]:
+        o = r["options"]
+        out.append(f"| {o.get('drive_omega', 50.0):g} | {o.get('drive_damping_ratio', 1.0):g} | "
+                   f"{o.get('gripper_mass', 13.0):g} | {r['any']:.1f} | {r['final']:.1f} | {r['long']:.1f} | "
+                   f"{r['short']:.1f} | {r['launch_over_want']:.3f} | {r.get('response_rms', float('nan')):.4f} |")
+    return "\n".join(out)
+
+
+def plot(results: list[dict], grid: dict | None, path: str) -> None:
+    """Left: success against the mean launch speed (grid of ours, and each side's run); right: where
+    the pucks end along the line."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
+    if grid:
+        x = [r["launch_over_want"] for r in grid["runs"]]
+        a.scatter(x, [r["any"] for r in grid["runs"]], marker="^", color="0.6", label="ours, other drives: any step")
+        a.scatter(x, [r["final"] for r in grid["runs"]], marker="v", color="0.3",
+                  label="ours, other drives: final step")
+    for r, colour in zip(results, ("tab:red", "tab:blue", "tab:green"), strict=False):
+        s = stats(r)
+        a.scatter([s["launch_over_want"][0]] * 2, [s["any"], s["final"]], s=90, marker="*", color=colour,
+                  label=f"{r['side']} (any, final)")
+        along = np.array([e["along"] for e in r["episodes"]])
+        b.hist(np.clip(along, -0.15, 0.15), bins=np.linspace(-0.15, 0.15, 61), histtype="step", color=colour,
+               label=r["side"])
+    a.set_xlabel("mean peak puck speed / wanted launch speed")
+    a.set_ylabel("scripted Slide success (%)")
+    a.grid(alpha=0.3)
+    b.axvspan(-0.05, 0.05, color="0.9", label="within 5 cm along the line")
+    b.set_xlabel("puck's end along the start-goal line, m (> 0: past the goal; clipped at +-0.15)")
+    b.set_ylabel("episodes")
+    for ax in (a, b):
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2, fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--side", choices=("reference", "ours"))
+    p.add_argument("--episodes", type=int, default=200)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--drive-omega", type=float, help="ours: drive natural frequency, rad/s (default 50)")
+    p.add_argument("--drive-damping-ratio", type=float, help="ours: drive damping ratio (default 1)")
+    p.add_argument("--gripper-mass", type=float, help="ours: gripper mass, kg (default 13)")
+    p.add_argument("--grid", action="store_true", help="ours: every drive in GRID_DRIVES, then every GRID_MASSES")
+    p.add_argument("--reference-json", help="with --grid: a --side reference run, to score each drive against")
+    p.add_argument("--out", help="JSON file for the run")
+    p.add_argument("--summary", nargs="+", metavar="JSON", help="print a markdown table of these runs and exit")
+    p.add_argument("--grid-json", help="with --summary: a --grid run to tabulate and plot")
+    p.add_argument("--png", help="with --summary: draw the figure here")
+    args = p.parse_args(argv)
+    if args.summary:
+        results = [json.loads(Path(f).read_text()) for f in args.summary]
+        grid = json.loads(Path(args.grid_json).read_text()) if args.grid_json else None
+        print(summary(results))
+        if grid:
+            print("\n" + grid_table(grid))
+        if args.png:
+            plot(results, grid, args.png)
+            print("wrote", args.png)
+        return 0
+    if args.side is None:
+        p.error("--side is required unless --summary is given")
+    if args.side == "reference":
+        if args.grid or args.drive_omega or args.drive_damping_ratio or args.gripper_mass:
+            p.error("--grid and the model options are for --side ours")
+        result = run_reference(args.episodes, args.seed)
+    elif args.grid:
+        runs = [dict(drive_omega=w, drive_damping_ratio=z) for w, z in GRID_DRIVES]
+        runs += [dict(gripper_mass=mass) for mass in GRID_MASSES]
+        result = {"side": "ours grid", "date": datetime.date.today().isoformat(), "command": " ".join(sys.argv),
+                  "runs": []}
+        ref = json.loads(Path(args.reference_json).read_text()) if args.reference_json else None
+        for options in runs:
+            run = run_ours(args.episodes, args.seed, **options)
+            s = stats(run)
+            row = {"options": options, **{k: s[k] for k in ("any", "final", "long", "short")},
+                   "launch_over_want": s["launch_over_want"][0]}
+            if ref:
+                row["response_rms"] = response_rms(run, ref)
+            result["runs"].append(row)
+            print(options, {k: round(v, 4) for k, v in row.items() if k != "options"}, flush=True)
+        if ref:
+            result["identified"] = identify(result["runs"], stats(ref)["launch_over_want"][0])
+            print("identified drive:", result["identified"])
+    else:
+        opts = {k: v for k, v in (("drive_omega", args.drive_omega), ("drive_damping_ratio", args.drive_damping_ratio),
+                                  ("gripper_mass", args.gripper_mass)) if v is not None}
+        result = run_ours(args.episodes, args.seed, **opts)
+    if "episodes" in result and isinstance(result["episodes"], list):
+        print(summary([result]))
+    if args.out:
+        Path(args.out).write_text(json.dumps(result, indent=1) + "\n")
+        print("wrote", args.out)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
