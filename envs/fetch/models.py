@@ -145,13 +145,16 @@ def mjcf(
     gripper_mass: float | None = None,
     drive_omega: float = DRIVE_OMEGA,
     drive_damping_ratio: float = 1.0,
+    drive_damping: str = "joint",
 ) -> str:
     """The MJCF text of task ``kind`` (one of ``KINDS``); ``table`` is the table's collision shape
     (``tables_for(kind)``), ``finger`` the closed finger block's (``fingers_for(kind)``).
 
     ``gripper_mass`` (default: the task's), ``drive_omega`` and ``drive_damping_ratio`` change the xyz
-    drive (kp = m w^2, damping 2 z m w) for sensitivity studies (``experiments/parity/slide_strike.py``);
-    the tasks use the defaults."""
+    drive (kp = m w^2, damping 2 z m w) for sensitivity studies (``experiments/parity/slide_strike.py``).
+    ``drive_damping`` is where that damping acts: ``"joint"`` (default) as joint damping, which the Euler
+    integrator treats implicitly; ``"actuator"`` as the actuators' velocity feedback, explicit like the
+    damping term of the reference weld's reference acceleration."""
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
     if table not in tables_for(kind):
@@ -162,6 +165,8 @@ def mjcf(
                         ("drive_damping_ratio", drive_damping_ratio)):
         if value is not None and not value > 0:
             raise ValueError(f"{name} must be > 0, got {value}")
+    if drive_damping not in ("joint", "actuator"):
+        raise ValueError(f"drive_damping must be 'joint' or 'actuator', got {drive_damping!r}")
     (tx, ty, tz), (hx, hy, hz), (gx, gy, gz) = _SCENES[kind]
     has_object = kind != "reach"
     free_fingers = kind == "pick_and_place"
@@ -169,6 +174,7 @@ def mjcf(
     mass = gripper_mass if gripper_mass is not None else SLIDE_GRIPPER_MASS if slide else GRIPPER_MASS
     w = drive_omega
     kp, kv = mass * w * w, 2.0 * drive_damping_ratio * mass * w
+    joint_kv, bias_kv = (f"{kv:.6g}", "0") if drive_damping == "joint" else ("0", f"{-kv:.6g}")
     obj_half = (OBJECT_HALF, OBJECT_HALF, PUCK_HALF_HEIGHT if slide else OBJECT_HALF)
     rest_z = TABLE_TOP + obj_half[2]
     ox, oy = gx + 0.1, gy + 0.1  # any spot on the table; reset moves it
@@ -260,9 +266,9 @@ def mjcf(
     <geom name="floor" type="plane" size="3 3 0.1" {nograv} rgba="0.8 0.8 0.8 1"/>
     {table}
     <body name="gripper" pos="{_fmt(gx, gy, gz)}">
-      <joint name="grip_x" type="slide" axis="1 0 0" damping="{kv:.6g}"/>
-      <joint name="grip_y" type="slide" axis="0 1 0" damping="{kv:.6g}"/>
-      <joint name="grip_z" type="slide" axis="0 0 1" damping="{kv:.6g}"/>
+      <joint name="grip_x" type="slide" axis="1 0 0" damping="{joint_kv}"/>
+      <joint name="grip_y" type="slide" axis="0 1 0" damping="{joint_kv}"/>
+      <joint name="grip_z" type="slide" axis="0 0 1" damping="{joint_kv}"/>
       <site name="grip" pos="0 0 0" size="0.005"/>
       <geom name="palm" type="box" size="0.02 0.04 0.01" pos="0 0 0.062" mass="{palm_mass:.6g}" {nograv}
             rgba="0.3 0.3 0.3 1"/>{fingers}
@@ -271,10 +277,10 @@ def mjcf(
   <contact>{obj_pairs}{finger_pairs}
   </contact>
   <actuator>
-    <general name="grip_x" joint="grip_x" gainprm="{kp:.6g}" biastype="affine" biasprm="0 {-kp:.6g} 0"/>
-    <general name="grip_y" joint="grip_y" gainprm="{kp:.6g}" biastype="affine" biasprm="0 {-kp:.6g} 0"/>
+    <general name="grip_x" joint="grip_x" gainprm="{kp:.6g}" biastype="affine" biasprm="0 {-kp:.6g} {bias_kv}"/>
+    <general name="grip_y" joint="grip_y" gainprm="{kp:.6g}" biastype="affine" biasprm="0 {-kp:.6g} {bias_kv}"/>
     <general name="grip_z" joint="grip_z" gainprm="{kp:.6g}" biastype="affine"
-             biasprm="{mass * 9.81:.6g} {-kp:.6g} 0"/>{finger_act}
+             biasprm="{mass * 9.81:.6g} {-kp:.6g} {bias_kv}"/>{finger_act}
   </actuator>
 </mujoco>
 """

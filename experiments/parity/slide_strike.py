@@ -147,14 +147,14 @@ def run_reference(episodes: int, seed: int) -> dict:
     return _result("reference", records, speeds, {"gymnasium_robotics": gymnasium_robotics.__version__})
 
 
-def run_ours(episodes: int, seed: int, **model_options) -> dict:
+def run_ours(episodes: int, seed: int, timestep: float = 0.004, substeps: int = 10, **model_options) -> dict:
     """Our Slide MJCF in MuJoCo C through ``slide_c.run`` (our reset, control step and controller)."""
     import slide_c
 
     sys.path.insert(0, str(ROOT))
     from envs.fetch import models, scripted
 
-    xml = models.mjcf("slide", 0.004, 10, 4, **model_options)
+    xml = models.mjcf("slide", timestep, 10, 4, **model_options)
     m = mujoco.MjModel.from_xml_string(xml)
     fingers = [m.geom(f"tip_{i}").id for i in range(4)]
     puck, site, dof = m.geom("object").id, m.site("grip").id, int(m.joint("object").dofadr[0])
@@ -163,7 +163,7 @@ def run_ours(episodes: int, seed: int, **model_options) -> dict:
     for i in range(episodes):
         _, u = _launch(scripted, obj_xy[i], goal_xy[i])
         recs.append(Recorder(m, fingers, puck, site, dof, u))
-    r = slide_c.run(xml, 0.004, 10, episodes, seed, ep_starts=(obj_xy, goal_xy),
+    r = slide_c.run(xml, timestep, substeps, episodes, seed, ep_starts=(obj_xy, goal_xy),
                     on_substep=lambda i, m_, d_: recs[i](m_, d_))
     records = []
     for i, rec in enumerate(recs):
@@ -176,11 +176,13 @@ def run_ours(episodes: int, seed: int, **model_options) -> dict:
     d.qpos[q : q + 3] = [0.6, 0.35, 0.42]
     mujoco.mj_forward(m, d)
     speeds = []
+    every = round(0.004 / timestep)
     for a in RESPONSE_ACTIONS:
         d.ctrl[0:3] = d.qpos[g : g + 3] + 0.05 * np.asarray(a)
-        for _ in range(10):
+        for k in range(substeps):
             mujoco.mj_step(m, d)
-            speeds.append(float(d.qvel[g]))
+            if (k + 1) % every == 0:
+                speeds.append(float(d.qvel[g]))
     return _result("ours", records, speeds, {"mujoco": mujoco.__version__, "model_options": model_options})
 
 
@@ -317,6 +319,8 @@ def main(argv=None) -> int:
     p.add_argument("--drive-omega", type=float, help="ours: drive natural frequency, rad/s (default 50)")
     p.add_argument("--drive-damping-ratio", type=float, help="ours: drive damping ratio (default 1)")
     p.add_argument("--gripper-mass", type=float, help="ours: gripper mass, kg (default 13)")
+    p.add_argument("--drive-damping", choices=("joint", "actuator"),
+                   help="ours: the drive's damping as implicit joint damping (default) or explicit actuator feedback")
     p.add_argument("--grid", action="store_true", help="ours: every drive in GRID_DRIVES, then every GRID_MASSES")
     p.add_argument("--reference-json", help="with --grid: a --side reference run, to score each drive against")
     p.add_argument("--out", help="JSON file for the run")
@@ -337,7 +341,7 @@ def main(argv=None) -> int:
     if args.side is None:
         p.error("--side is required unless --summary is given")
     if args.side == "reference":
-        if args.grid or args.drive_omega or args.drive_damping_ratio or args.gripper_mass:
+        if args.grid or args.drive_omega or args.drive_damping_ratio or args.gripper_mass or args.drive_damping:
             p.error("--grid and the model options are for --side ours")
         result = run_reference(args.episodes, args.seed)
     elif args.grid:
@@ -360,7 +364,8 @@ def main(argv=None) -> int:
             print("identified drive:", result["identified"])
     else:
         opts = {k: v for k, v in (("drive_omega", args.drive_omega), ("drive_damping_ratio", args.drive_damping_ratio),
-                                  ("gripper_mass", args.gripper_mass)) if v is not None}
+                                  ("gripper_mass", args.gripper_mass), ("drive_damping", args.drive_damping))
+                if v is not None}
         result = run_ours(args.episodes, args.seed, **opts)
     if "episodes" in result and isinstance(result["episodes"], list):
         print(summary([result]))
