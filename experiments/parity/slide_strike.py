@@ -285,7 +285,7 @@ def plot(results: list[dict], grid: dict | None, path: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.6))
     if grid:
         x = [r["launch_over_want"] for r in grid["runs"]]
         a.scatter(x, [r["any"] for r in grid["runs"]], marker="^", color="0.6", label="ours, other drives: any step")
@@ -302,10 +302,11 @@ def plot(results: list[dict], grid: dict | None, path: str) -> None:
     a.set_ylabel("scripted Slide success (%)")
     a.grid(alpha=0.3)
     b.axvspan(-0.05, 0.05, color="0.9", label="within 5 cm along the line")
-    b.set_xlabel("puck's end along the start-goal line, m (> 0: past the goal; clipped at +-0.15)")
+    b.set_xlabel("where the puck ends along the start-goal line, m\n"
+                 "(> 0: past the goal; beyond +-0.15 drawn at +-0.15)")
     b.set_ylabel("episodes")
     for ax in (a, b):
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2, fontsize=8)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.18 if ax is a else -0.26), ncol=2, fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
