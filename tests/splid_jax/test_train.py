@@ -22,9 +22,18 @@ TINY = ["--env", "point", "--num-envs", "8", "--eval-episodes", "16", "--bc-step
 VOLATILE = {"wall_s", "steps_per_s"}
 
 
+# A shell starts background jobs with SIGINT ignored, and a child inherits that: the Ctrl-C test would
+# then test nothing when pytest itself runs in the background. This prelude gives the run the Ctrl-C
+# handling it has when started from a terminal.
+AT_A_TERMINAL = (
+    "import runpy, signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+    "sys.argv[0] = 'splid_jax.train'; runpy.run_module('splid_jax.train', run_name='__main__', alter_sys=True)"
+)
+
+
 def cli(*args, **kw):
     return subprocess.Popen(
-        [sys.executable, "-m", "splid_jax.train", *args],
+        [sys.executable, "-c", AT_A_TERMINAL, *args],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
