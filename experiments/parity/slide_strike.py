@@ -43,12 +43,16 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(HERE))
+sys.path.insert(1, str(ROOT))  # envs, for our side only: the reference's environment has no flax
 
 DECEL = 0.1 * 9.81  # the puck-table friction's deceleration, as the controller assumes
 RESPONSE_ACTIONS = [(0.16, 0.0, 0.0)] * 5 + [(0.9, 0.0, 0.0)] * 3  # close in at 8 mm / step, then jump 4.5 cm
 RESPONSE_FROM_STEP = 5  # the jump
 GRID_DRIVES = list(itertools.product((45.0, 50.0, 52.5, 55.0, 57.5, 60.0), (0.9, 1.0, 1.05, 1.1, 1.15, 1.2, 1.25)))
-GRID_MASSES = (10.0, 13.0, 16.0, 20.0)
+GRID_MASSES = (10.0, 16.0, 20.0)  # the default 13 kg is the default drive's row of GRID_DRIVES
+# envs.fetch.models' Slide defaults, written out: this file also runs where envs cannot be imported
+DEFAULT_DRIVE = {"drive_omega": 50.0, "drive_damping_ratio": 1.0}
+DEFAULT_GRIPPER_MASS = 13.0
 
 
 class Recorder:
@@ -147,27 +151,26 @@ def run_reference(episodes: int, seed: int) -> dict:
     return _result("reference", records, speeds, {"gymnasium_robotics": gymnasium_robotics.__version__})
 
 
-def run_ours(episodes: int, seed: int, timestep: float = 0.004, substeps: int = 10, **model_options) -> dict:
-    """Our Slide MJCF in MuJoCo C through ``slide_c.run`` (our reset, control step and controller)."""
+def run_ours(
+    episodes: int, seed: int, timestep: float = 0.004, substeps: int = 10, ep_starts=None, **model_options
+) -> dict:
+    """Our Slide MJCF in MuJoCo C through ``slide_c.run`` (our reset, control step and controller).
+    ``ep_starts`` (``slide_c.starts(episodes, seed)``) may be passed to reuse them across runs."""
     import slide_c
 
-    sys.path.insert(0, str(ROOT))
     from envs.fetch import models, scripted
 
     xml = models.mjcf("slide", timestep, 10, 4, **model_options)
     m = mujoco.MjModel.from_xml_string(xml)
     fingers = [m.geom(f"tip_{i}").id for i in range(4)]
     puck, site, dof = m.geom("object").id, m.site("grip").id, int(m.joint("object").dofadr[0])
-    obj_xy, goal_xy = slide_c.starts(episodes, seed)
-    recs = []
-    for i in range(episodes):
-        _, u = _launch(scripted, obj_xy[i], goal_xy[i])
-        recs.append(Recorder(m, fingers, puck, site, dof, u))
+    obj_xy, goal_xy = slide_c.starts(episodes, seed) if ep_starts is None else ep_starts
+    launches = [_launch(scripted, obj_xy[i], goal_xy[i]) for i in range(episodes)]
+    recs = [Recorder(m, fingers, puck, site, dof, u) for _, u in launches]
     r = slide_c.run(xml, timestep, substeps, episodes, seed, ep_starts=(obj_xy, goal_xy),
                     on_substep=lambda i, m_, d_: recs[i](m_, d_))
     records = []
-    for i, rec in enumerate(recs):
-        want, _ = _launch(scripted, obj_xy[i], goal_xy[i])
+    for i, (rec, (want, _)) in enumerate(zip(recs, launches, strict=True)):
         along, across = _landing(obj_xy[i], goal_xy[i], r["final"][i, :2])
         records.append(_record(bool(r["succ"][:, i].any()), bool(r["succ"][-1, i]), want, rec, along, across))
 
@@ -237,7 +240,7 @@ def identify(runs: list[dict], reference_launch: float) -> dict:
     as close to the reference's as the default drive's, the one whose mean launch speed is closest to the
     reference's."""
     drives = [r for r in runs if "gripper_mass" not in r["options"]]
-    default = next(r for r in drives if r["options"] == {"drive_omega": 50.0, "drive_damping_ratio": 1.0})
+    default = next(r for r in drives if r["options"] == DEFAULT_DRIVE)
     ok = [r for r in drives if r["response_rms"] <= default["response_rms"] + 1e-12]
     return min(ok, key=lambda r: abs(r["launch_over_want"] - reference_launch))
 
@@ -270,10 +273,10 @@ def grid_table(grid: dict) -> str:
            "| peak puck speed / wanted | free-space RMS vs reference (m/s) |",
            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in grid["runs"]:
-        o = r["options"]
-        out.append(f"| {o.get('drive_omega', 50.0):g} | {o.get('drive_damping_ratio', 1.0):g} | "
-                   f"{o.get('gripper_mass', 13.0):g} | {r['any']:.1f} | {r['final']:.1f} | {r['long']:.1f} | "
-                   f"{r['short']:.1f} | {r['launch_over_want']:.3f} | {r.get('response_rms', float('nan')):.4f} |")
+        o = {**DEFAULT_DRIVE, "gripper_mass": DEFAULT_GRIPPER_MASS, **r["options"]}
+        out.append(f"| {o['drive_omega']:g} | {o['drive_damping_ratio']:g} | {o['gripper_mass']:g} | "
+                   f"{r['any']:.1f} | {r['final']:.1f} | {r['long']:.1f} | {r['short']:.1f} | "
+                   f"{r['launch_over_want']:.3f} | {r.get('response_rms', float('nan')):.4f} |")
     return "\n".join(out)
 
 
@@ -351,8 +354,11 @@ def main(argv=None) -> int:
         result = {"side": "ours grid", "date": datetime.date.today().isoformat(), "command": " ".join(sys.argv),
                   "runs": []}
         ref = json.loads(Path(args.reference_json).read_text()) if args.reference_json else None
+        import slide_c
+
+        starts = slide_c.starts(args.episodes, args.seed)
         for options in runs:
-            run = run_ours(args.episodes, args.seed, **options)
+            run = run_ours(args.episodes, args.seed, ep_starts=starts, **options)
             s = stats(run)
             row = {"options": options, **{k: s[k] for k in ("any", "final", "long", "short")},
                    "launch_over_want": s["launch_over_want"][0]}

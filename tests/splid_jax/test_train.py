@@ -26,8 +26,8 @@ VOLATILE = {"wall_s", "steps_per_s"}
 # then test nothing when pytest itself runs in the background. This prelude gives the run the Ctrl-C
 # handling it has when started from a terminal.
 AT_A_TERMINAL = (
-    "import runpy, signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
-    "sys.argv[0] = 'splid_jax.train'; runpy.run_module('splid_jax.train', run_name='__main__', alter_sys=True)"
+    "import runpy, signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
+    "runpy.run_module('splid_jax.train', run_name='__main__', alter_sys=True)"
 )
 
 
