@@ -21,6 +21,12 @@ target moved 5 cm ahead at every control step alike: the grip advances 3.0 cm in
 then 3.4 cm per step (weld: 3.2 cm), and stops within 0.2 mm of the target once it is held, so
 neither reaches the full 5 cm within one step, the reference's weld (same time constant) neither.
 
+Reach. The reference's gripper hangs on a 7-joint arm, ours on none: the tasks keep each target
+within the arm's measured reach (``within_reach``, task field ``workspace``). Driven at full action
+toward a far target the reference's gripper slows as the arm straightens and stops on a sphere; ours,
+with the reach, stops on the same sphere and comes within 1.5 cm of the reference's path on the way
+(experiments/parity/arm_reach.py). Only Slide, whose robot stands further back, meets it in play.
+
 Contact pairs: object-table (plane-box), finger(s)-object (box-box); Slide's are below. The gripper
 has no pair with the table: its z target is clipped so that the fingertips stay at or above the
 table top instead (see ``Layout.workspace``).
@@ -97,6 +103,35 @@ _SCENES = {
     "slide": ((1.32, 0.75, 0.2), (0.625, 0.45, 0.2), (1.013, 0.749, 0.416)),
 }
 KINDS = tuple(_SCENES)
+
+
+# The reference arm's reach (experiments/parity/arm_reach.py). Its grip site, pulled by the mocap weld
+# toward a target out of reach, stops on a sphere around a point near the shoulder (36 stops per robot
+# placement fit it to 0.7 mm), and slows as the arm straightens: near the sphere it gains at most about
+# ARM_STRETCH_GAIN * sqrt(distance left) outward per control step, as a two-link arm near full
+# extension does. FetchSlide stands the robot 0.355 m further back than the other tasks, so only
+# Slide's goals (x up to 1.71) lie beyond it: its gripper reaches x 1.39 at table height.
+ARM_REACH_RADIUS = 1.126
+ARM_REACH_CENTER = {"slide": (0.319, 0.744, 0.781)}
+ARM_REACH_CENTER_DEFAULT = (0.674, 0.744, 0.781)
+ARM_STRETCH_GAIN = 0.10  # m^0.5 per control step: the target's outward step is capped at this * sqrt(R - r)
+WORKSPACES = ("arm", "box")
+
+
+def within_reach(grip, target, center, radius=ARM_REACH_RADIUS, stretch_gain=ARM_STRETCH_GAIN, xp=np):
+    """The gripper target (world xyz, [..., 3]) the reference arm would follow from ``grip``: its step
+    away from ``center`` capped at ``stretch_gain * sqrt(radius - r)`` (r: the grip's distance from
+    ``center``), then moved onto the ball of ``radius`` if outside it. ``xp``: numpy or jax.numpy."""
+    center = xp.asarray(center)
+    off = grip - center
+    r = xp.sqrt(xp.sum(off * off, axis=-1, keepdims=True))
+    n = off / xp.maximum(r, 1e-9)
+    outward = xp.sum((target - grip) * n, axis=-1, keepdims=True)
+    cap = stretch_gain * xp.sqrt(xp.maximum(radius - r, 0.0))
+    target = target - n * xp.maximum(outward - cap, 0.0)
+    off = target - center
+    dist = xp.sqrt(xp.sum(off * off, axis=-1, keepdims=True))
+    return center + off * xp.minimum(1.0, radius / xp.maximum(dist, 1e-9))
 TABLES = ("plane", "box")
 
 
@@ -124,6 +159,8 @@ class Layout:
     grip_home: tuple[float, float, float]  # grip-site position when the gripper joints are 0
     workspace_lo: tuple[float, float, float]  # clip box of the grip-site target
     workspace_hi: tuple[float, float, float]
+    reach_center: tuple[float, float, float]  # the reference arm's reach ball (ARM_REACH_*)
+    reach_radius: float
     object_rest_z: float | None  # object centre height at rest on the table
     nq: int
     nv: int
@@ -323,6 +360,8 @@ def build(kind: str, **options):
         grip_home=tuple(float(x) for x in home),
         workspace_lo=lo,
         workspace_hi=hi,
+        reach_center=ARM_REACH_CENTER.get(kind, ARM_REACH_CENTER_DEFAULT),
+        reach_radius=ARM_REACH_RADIUS,
         object_rest_z=rest_z,
         nq=int(m.nq),
         nv=int(m.nv),

@@ -7,8 +7,10 @@ position (grip position for Reach), sparse reward ``-(d > threshold)``, 50-step 
 
 Gripper target. As in the reference (mocap body reset onto the gripper, then moved by the delta),
 each control step sets the xyz target to the *current* grip position plus ``0.05 * a[:3]``, clipped
-to a workspace box whose floor keeps the fingertips at or above the table top. The target is the
-actuator control, which ``Physics`` holds, so nothing else needs saving.
+to a workspace box whose floor keeps the fingertips at or above the table top, then within the
+reference arm's reach (``models.within_reach``: the gripper slows as it nears the arm's reach and
+stops on its sphere, as the reference's does; ``workspace="box"`` drops this). The target is the actuator control, which
+``Physics`` holds, so nothing else needs saving.
 
 ``State.physics`` (a ``Physics``) is the complete simulator state: qpos, qvel, ctrl, time and the
 Newton solver's warm start. ``step`` rebuilds an ``mjx.Data`` from it, so restoring a saved ``State``
@@ -113,6 +115,7 @@ class _FetchTask(GoalEnv):
     cholesky: str = "unrolled"  # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     drive_omega: float = models.DRIVE_OMEGA  # rad/s: natural frequency of the gripper's xyz drive
     drive_damping_ratio: float = 1.0  # of the same drive (models.mjcf)
+    workspace: str = "arm"  # where the gripper target may go: the box and the reference arm's reach, or the box
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -135,6 +138,7 @@ class _FetchTask(GoalEnv):
         check(self.table in tables, f"{n}.table", self.table, "one of " + ", ".join(tables))
         fingers = models.fingers_for(n)
         check(self.finger in fingers, f"{n}.finger", self.finger, "one of " + ", ".join(fingers))
+        check(self.workspace in models.WORKSPACES, f"{n}.workspace", self.workspace, "one of arm, box")
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
         check(10 <= self.drive_omega <= 200, f"{n}.drive_omega", self.drive_omega, "in [10, 200] rad/s")
         check(0.5 <= self.drive_damping_ratio <= 3, f"{n}.drive_damping_ratio", self.drive_damping_ratio, "in [0.5, 3]")
@@ -298,6 +302,9 @@ class _FetchTask(GoalEnv):
         g = lay.grip_q
         target = phys.qpos[g : g + 3] + 0.05 * action[:3]
         target = jnp.clip(target, jnp.asarray(lay.workspace_lo) - home, jnp.asarray(lay.workspace_hi) - home)
+        if self.workspace == "arm":
+            grip = phys.qpos[g : g + 3] + home
+            target = models.within_reach(grip, target + home, lay.reach_center, lay.reach_radius, xp=jnp) - home
         ctrl = phys.ctrl.at[0:3].set(target)
         if lay.finger_q is not None:
             f = lay.finger_q

@@ -49,9 +49,11 @@ def run(
     steps: int = 50,
     ep_starts=None,
     on_substep=None,
+    workspace="arm",
 ):
     """Run the slide controller on ``xml``; returns a dict of per-episode arrays. ``on_substep(i, m, d)``,
-    if given, is called after every MuJoCo step of episode ``i``."""
+    if given, is called after every MuJoCo step of episode ``i``. ``workspace`` is the task field's:
+    "arm" also keeps the gripper target within the reference arm's reach, "box" does not."""
     import jax
 
     from envs.fetch import models, scripted
@@ -66,6 +68,7 @@ def run(
     lo = np.array([tx - hx - 0.15, ty - hy - 0.15, models.TABLE_TOP + models.FINGER_BELOW_SITE]) - home
     hi = np.array([tx + hx + 0.15, ty + hy + 0.15, models.TABLE_TOP + 0.6]) - home
     rest_z = models._rest_height(m, o)
+    reach_center = models.ARM_REACH_CENTER["slide"]
     obj_xy, goal_xy = starts(episodes, seed) if ep_starts is None else ep_starts
     goal = np.concatenate([goal_xy, np.full((episodes, 1), rest_z)], axis=1)
     ds = []
@@ -100,6 +103,8 @@ def run(
             if bad[i]:
                 continue
             target = np.clip(d.qpos[g : g + 3] + 0.05 * act[i, :3], lo, hi)
+            if workspace == "arm":
+                target = models.within_reach(home + d.qpos[g : g + 3], home + target, reach_center) - home
             d.ctrl[0:3] = target
             for _ in range(substeps):
                 mujoco.mj_step(m, d)
