@@ -130,12 +130,26 @@ def launch_velocity(displacement, decel):
     return v * jnp.sign(displacement)
 
 
-def slide(obs, goal, gain=SLIDE_GAIN, friction=SLIDE_FRICTION, push_gain=SLIDE_PUSH_GAIN, approach_speed=0.2):
+def slide(
+    obs,
+    goal,
+    gain=SLIDE_GAIN,
+    friction=SLIDE_FRICTION,
+    push_gain=SLIDE_PUSH_GAIN,
+    approach_speed=0.2,
+    aim_short=0.0,
+    trail_gap=None,
+):
     """Slide the puck to ``goal``: line up the fingers' corner behind it on the launch line (the
     direction of ``launch_velocity``, which bends with the friction cone), descend, close in slowly and
     push at the launch speed from which friction alone stops the puck on the goal. As the remaining
     distance shrinks the wanted speed drops, so the puck glides on alone; when it stops short the
     gripper, still on the line, catches up and pushes again.
+
+    The re-push variant: ``aim_short`` (a fraction) launches the puck to stop that much of the way
+    short, and ``trail_gap`` (metres) has the gripper follow a gliding puck that far behind, so it is
+    at hand to push again where the puck stops. Whether that works depends on where the gripper can
+    reach (``tasks`` field ``workspace``), which is what it was written to show (experiments/parity).
     """
     _, grip, obj, goal = _parts(obs, goal)
     d = goal[..., :2] - obj[..., :2]
@@ -143,6 +157,7 @@ def slide(obs, goal, gain=SLIDE_GAIN, friction=SLIDE_FRICTION, push_gain=SLIDE_P
     v_launch = launch_velocity(d, friction * GRAVITY)
     speed = _norm(v_launch)
     u = v_launch / jnp.maximum(speed, 1e-6)
+    speed = speed * jnp.sqrt(1.0 - aim_short)  # friction stops it (1 - aim_short) of the way
     corner = jnp.where(u >= 0, 1.0, -1.0) * jnp.asarray(FINGER_HALF_XY, jnp.float32)
     tip = grip[..., :2] + corner
     rel = tip - obj[..., :2]
@@ -163,6 +178,9 @@ def slide(obs, goal, gain=SLIDE_GAIN, friction=SLIDE_FRICTION, push_gain=SLIDE_P
     in_contact = gap < SLIDE_CONTACT
     approach = jnp.clip(gap - 0.5 * SLIDE_CONTACT, 0.0, approach_speed * DT)
     push_adv = jnp.where(v_puck < v_des, push_gain * v_des * DT, 0.0)
+    if trail_gap is not None:  # keep up with a gliding puck, trail_gap behind it, to push again where it stops
+        trail = jnp.clip(gap - trail_gap + jnp.maximum(v_puck, 0.0) * DT, 0.0, MAX_STEP)
+        approach = jnp.where(v_puck > approach_speed, trail, approach)
     advance = jnp.where(in_contact, push_adv, approach)
     target_tip = obj[..., :2] + u * (along + advance)
     follow_move = _toward(grip, jnp.concatenate([target_tip - corner, low_z], axis=-1))

@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import datetime
+import functools
 import io
 import json
 import os
@@ -57,13 +58,14 @@ def rollout_fn(env, controller, episodes: int):
     return jax.jit(lambda key: jax.vmap(one)(jax.random.split(key, episodes)))
 
 
-def run_task(task: str, episodes: int, seed: int, overrides: dict | None = None) -> dict:
+def run_task(task: str, episodes: int, seed: int, overrides: dict | None = None,
+             controller_kwargs: dict | None = None) -> dict:
     import envs
     from envs.fetch import scripted
 
     with contextlib.redirect_stdout(io.StringIO()):  # mujoco.mjx prints a warp notice on import
         env = envs.make(task, **(overrides or {}))
-        fn = rollout_fn(env, scripted.CONTROLLERS[task], episodes)
+        fn = rollout_fn(env, functools.partial(scripted.CONTROLLERS[task], **(controller_kwargs or {})), episodes)
         key = jax.random.PRNGKey(seed)
         t0 = time.perf_counter()
         compiled = fn.lower(key).compile()
@@ -96,6 +98,11 @@ def run_task(task: str, episodes: int, seed: int, overrides: dict | None = None)
     }
 
 
+def _pairs(items) -> dict:
+    """``["a=1", "b=\"x\""]`` -> ``{"a": 1, "b": "x"}`` (values as JSON)."""
+    return {k: json.loads(v) for k, _, v in (item.partition("=") for item in items)}
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--tasks", default=",".join(TASKS))
@@ -104,11 +111,11 @@ def main(argv=None) -> int:
     p.add_argument("--out", default=str(ROOT / "experiments" / "parity" / "results" / "ours.json"))
     p.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE",
                    help="task field override for every task, e.g. --set iterations=10 (repeatable)")
+    p.add_argument("--controller", action="append", default=[], metavar="ARG=VALUE",
+                   help="keyword argument of the scripted controllers, e.g. --controller aim_short=0.08 (repeatable)")
     args = p.parse_args(argv)
-    overrides = {}
-    for item in args.set:
-        field, _, value = item.partition("=")
-        overrides[field] = json.loads(value)
+    overrides = _pairs(args.set)
+    controller_kwargs = _pairs(args.controller)
 
     import mujoco
 
@@ -124,10 +131,11 @@ def main(argv=None) -> int:
         "episodes": args.episodes,
         "seed": args.seed,
         "overrides": overrides,
+        "controller_kwargs": controller_kwargs,
         "tasks": {},
     }
     for task in args.tasks.split(","):
-        res = run_task(task, args.episodes, args.seed, overrides)
+        res = run_task(task, args.episodes, args.seed, overrides, controller_kwargs)
         out["tasks"][task] = res
         recs = res["episodes"]
         sa = np.mean([r["success_any"] for r in recs])

@@ -129,7 +129,10 @@ def main(argv=None) -> int:
     p.add_argument("--bench-steps", type=int, default=5000, help="random-action steps per process; 0 skips")
     p.add_argument("--bench-task", default="push")
     p.add_argument("--procs", type=int, default=os.cpu_count())
+    p.add_argument("--controller", action="append", default=[], metavar="ARG=VALUE",
+                   help="keyword argument of the scripted controllers, e.g. --controller aim_short=0.08 (repeatable)")
     args = p.parse_args(argv)
+    controller_kwargs = {k: json.loads(v) for k, _, v in (item.partition("=") for item in args.controller)}
 
     import gymnasium_robotics
     import mujoco
@@ -143,11 +146,12 @@ def main(argv=None) -> int:
         "load_average_at_start": os.getloadavg(),
         "episodes": args.episodes,
         "seed": args.seed,
+        "controller_kwargs": controller_kwargs,
         "tasks": {},
     }
     for task in filter(None, args.tasks.split(",")):
         t0 = time.perf_counter()
-        recs = run_episodes(task, args.episodes, args.seed)
+        recs = run_episodes(task, args.episodes, args.seed, controller_kwargs)
         secs = time.perf_counter() - t0
         out["tasks"][task] = {"env": TASKS[task], "seconds": secs, "episodes": recs}
         sa = np.mean([r["success_any"] for r in recs])

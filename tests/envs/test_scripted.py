@@ -122,3 +122,24 @@ def test_slide_aims_corner_and_holds_while_puck_is_fast_enough():
     fast = make_obs(grip=grip, obj=puck, obj_vel=(0.05, 0.0, 0.0))
     a = np.asarray(scripted.slide(fast, goal))
     assert abs(a[0]) < 0.1
+
+
+def test_slide_repush_variant_aims_short_and_trails_a_gliding_puck():
+    goal = np.array([1.6, 0.75, 0.42])
+    puck = (1.0, 0.75, 0.42)
+    corner = scripted.FINGER_HALF_XY
+    grip = (1.0 - scripted.PUCK_RADIUS - 0.005 - corner[0], 0.75 - corner[1], 0.42)
+    # In contact, with the puck at 0.95 of the flick's launch speed: the flick pushes, a launch aimed
+    # 10 % short (speed x 0.949) already has what it needs and holds still.
+    v = float(np.linalg.norm(scripted.launch_velocity(jnp.asarray(goal[:2] - puck[:2]), 0.981)))
+    moving = make_obs(grip=grip, obj=puck, obj_vel=(0.95 * v * scripted.DT, 0.0, 0.0))
+    assert np.asarray(scripted.slide(moving, goal))[0] > 0.5
+    assert abs(np.asarray(scripted.slide(moving, goal, aim_short=0.1))[0]) < 0.1
+    # 5.5 cm behind a puck gliding at 0.5 m/s: the flick closes in at approach speed, the trailing
+    # gripper keeps up (2 cm per step) and closes the gap to trail_gap (2.5 cm more).
+    far = (grip[0] - 0.05, grip[1], 0.42)
+    gliding = make_obs(grip=far, obj=puck, obj_vel=(0.02, 0.0, 0.0))
+    flick = np.asarray(scripted.slide(gliding, goal))[0] * scripted.MAX_STEP
+    trail = np.asarray(scripted.slide(gliding, goal, trail_gap=0.03))[0] * scripted.MAX_STEP
+    assert flick == pytest.approx(0.2 * scripted.DT, abs=1e-5)
+    assert trail == pytest.approx(0.055 - 0.03 + 0.02, abs=1e-5)
