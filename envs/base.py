@@ -51,6 +51,11 @@ class State:
 class GoalEnv(abc.ABC):
     """Base for tasks. Subclasses are frozen dataclasses whose fields are the task's options."""
 
+    def settings(self) -> dict:
+        """Every option of this task, defaults included, by name: what a checkpoint records so that a
+        resume under changed task defaults is caught, not silently continued."""
+        return {"task": type(self).__name__, **{f.name: getattr(self, f.name) for f in dataclasses.fields(self)}}
+
     @property
     @abc.abstractmethod
     def obs_size(self) -> int: ...

@@ -45,6 +45,11 @@ def _identity(cfg: TrainConfig) -> dict:
     return json.loads(json.dumps(ident))
 
 
+def _env_settings(env: envs.GoalEnv) -> dict:
+    """The task's every option as JSON stores it: a resume under other task defaults fails naming one."""
+    return json.loads(json.dumps(env.settings()))
+
+
 def pop_select_steps(metrics: dict) -> np.ndarray:
     """Pops a chunk's per-iteration SELECT replay steps ([..., eval_every], int32 on the device) and
     sums them over the iterations in int64 (per member of a sweep, where there is a member axis)."""
@@ -77,7 +82,8 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
     wall_before, select_steps = 0.0, 0
     if resume:
         # the meta check comes first, so a changed setting is named rather than a leaf's shape
-        step, state, meta = checkpoint.restore(cfg.run_dir, state, expect_meta={"config": _identity(cfg)})
+        step, state, meta = checkpoint.restore(cfg.run_dir, state, expect_meta={"config": _identity(cfg)},
+                                               expect_meta_if_saved={"env": _env_settings(env)})
         wall_before = float(meta["wall_s"])
         kept = [r for r in _read_jsonl(metrics_path) if r["iteration"] <= step]
         select_steps = int(meta["select_steps"])
@@ -96,7 +102,8 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
     rec, chunks_done = {}, 0
 
     def save(st, it, total):
-        meta = {"config": _identity(cfg), "wall_s": wall_before + time.perf_counter() - start, "select_steps": total}
+        meta = {"config": _identity(cfg), "env": _env_settings(env),
+                "wall_s": wall_before + time.perf_counter() - start, "select_steps": total}
         with _interrupt_after():
             checkpoint.save(cfg.run_dir, it, st, meta)
 

@@ -201,3 +201,17 @@ def test_ctrl_c_during_a_checkpoint_write_waits_for_the_write(tmp_path):
     assert checkpoint.latest_step(str(tmp_path)) == 5  # written whole, then the interrupt came
     _, restored, _ = checkpoint.restore(str(tmp_path), state)
     np.testing.assert_array_equal(restored["w"], state["w"])
+
+
+def test_resume_under_changed_task_defaults_fails_naming_the_option(tmp_path):
+    # the same config both times; only the task itself differs, as after a change of its defaults
+    import envs
+    from splid_jax.checkpoint import CheckpointError
+
+    cfg = TrainConfig(env="point", num_envs=4, eval_episodes=4, bc_steps=2, batch_size=16, hidden=(8,),
+                      eval_every=5, iterations=5, run_dir=str(tmp_path / "run"))  # fmt: skip
+    run(cfg, env=envs.make("point"), quiet=True)
+    longer = TrainConfig(**{**cfg.__dict__, "iterations": 10})
+    with pytest.raises(CheckpointError, match=r"env\.door_half_width=0\.75 but env\.door_half_width=0\.5"):
+        run(longer, env=envs.make("point", door_half_width=0.5), resume=True, quiet=True)
+    assert run(longer, env=envs.make("point"), resume=True, quiet=True)["iteration"] == 10
