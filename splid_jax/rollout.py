@@ -30,7 +30,13 @@ def load_policy(run_dir: str):
         cfg = TrainConfig(**{**saved_fields(json.load(fh)), "run_dir": run_dir})
     env = make_env(cfg.env, **cfg.env_overrides())
     trainer = Trainer(env, cfg)
-    step, state, _ = checkpoint.restore(run_dir, trainer.init(jax.random.PRNGKey(0)))
+    step, state, meta = checkpoint.restore(run_dir, trainer.init(jax.random.PRNGKey(0)))
+    saved = meta.get("env")  # absent from checkpoints saved before tasks recorded their options
+    now = json.loads(json.dumps(env.settings()))
+    changed = [k for k in now if saved is not None and saved.get(k) != now[k]]
+    if changed:  # the policy is still worth a look under the changed task, so say it rather than stop
+        what = ", ".join(f"{k}={saved.get(k)!r} then, {now[k]!r} now" for k in changed)
+        print(f"note: {run_dir} was trained on another version of the task ({what})", file=sys.stderr)
     return env, trainer, state, step
 
 
