@@ -132,6 +132,8 @@ def within_reach(grip, target, center, radius=ARM_REACH_RADIUS, stretch_gain=ARM
     off = target - center
     dist = xp.sqrt(xp.sum(off * off, axis=-1, keepdims=True))
     return center + off * xp.minimum(1.0, radius / xp.maximum(dist, 1e-9))
+
+
 TABLES = ("plane", "box")
 
 

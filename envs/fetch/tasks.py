@@ -9,8 +9,8 @@ Gripper target. As in the reference (mocap body reset onto the gripper, then mov
 each control step sets the xyz target to the *current* grip position plus ``0.05 * a[:3]``, clipped
 to a workspace box whose floor keeps the fingertips at or above the table top, then within the
 reference arm's reach (``models.within_reach``: the gripper slows as it nears the arm's reach and
-stops on its sphere, as the reference's does; ``workspace="box"`` drops this). The target is the actuator control, which
-``Physics`` holds, so nothing else needs saving.
+stops on its sphere, as the reference's does; ``workspace="box"`` drops this). The target is the
+actuator control, which ``Physics`` holds, so nothing else needs saving.
 
 ``State.physics`` (a ``Physics``) is the complete simulator state: qpos, qvel, ctrl, time and the
 Newton solver's warm start. ``step`` rebuilds an ``mjx.Data`` from it, so restoring a saved ``State``
@@ -138,7 +138,8 @@ class _FetchTask(GoalEnv):
         check(self.table in tables, f"{n}.table", self.table, "one of " + ", ".join(tables))
         fingers = models.fingers_for(n)
         check(self.finger in fingers, f"{n}.finger", self.finger, "one of " + ", ".join(fingers))
-        check(self.workspace in models.WORKSPACES, f"{n}.workspace", self.workspace, "one of arm, box")
+        spaces = models.WORKSPACES
+        check(self.workspace in spaces, f"{n}.workspace", self.workspace, "one of " + ", ".join(spaces))
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
         check(10 <= self.drive_omega <= 200, f"{n}.drive_omega", self.drive_omega, "in [10, 200] rad/s")
         check(0.5 <= self.drive_damping_ratio <= 3, f"{n}.drive_damping_ratio", self.drive_damping_ratio, "in [0.5, 3]")
