@@ -17,7 +17,7 @@ from envs.base import InvalidConfig, step_batch
 from splid_jax import checkpoint
 from splid_jax.cli import add_compile_cache_flag, use_compile_cache
 from splid_jax.config import TrainConfig, saved_fields
-from splid_jax.train import make_env
+from splid_jax.train import env_settings, make_env
 from splid_jax.trainer import Trainer
 
 
@@ -32,7 +32,7 @@ def load_policy(run_dir: str):
     trainer = Trainer(env, cfg)
     step, state, meta = checkpoint.restore(run_dir, trainer.init(jax.random.PRNGKey(0)))
     saved = meta.get("env")  # absent from checkpoints saved before tasks recorded their options
-    now = json.loads(json.dumps(env.settings()))
+    now = env_settings(env)
     changed = [k for k in now if saved is not None and saved.get(k) != now[k]]
     if changed:  # the policy is still worth a look under the changed task, so say it rather than stop
         what = ", ".join(f"{k}={saved.get(k)!r} then, {now[k]!r} now" for k in changed)

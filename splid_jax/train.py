@@ -45,7 +45,7 @@ def _identity(cfg: TrainConfig) -> dict:
     return json.loads(json.dumps(ident))
 
 
-def _env_settings(env: envs.GoalEnv) -> dict:
+def env_settings(env: envs.GoalEnv) -> dict:
     """The task's every option as JSON stores it: a resume under other task defaults fails naming one."""
     return json.loads(json.dumps(env.settings()))
 
@@ -83,7 +83,7 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
     if resume:
         # the meta check comes first, so a changed setting is named rather than a leaf's shape
         step, state, meta = checkpoint.restore(cfg.run_dir, state, expect_meta={"config": _identity(cfg)},
-                                               expect_meta_if_saved={"env": _env_settings(env)})
+                                               expect_meta_if_saved={"env": env_settings(env)})
         wall_before = float(meta["wall_s"])
         kept = [r for r in _read_jsonl(metrics_path) if r["iteration"] <= step]
         select_steps = int(meta["select_steps"])
@@ -102,7 +102,7 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
     rec, chunks_done = {}, 0
 
     def save(st, it, total):
-        meta = {"config": _identity(cfg), "env": _env_settings(env),
+        meta = {"config": _identity(cfg), "env": env_settings(env),
                 "wall_s": wall_before + time.perf_counter() - start, "select_steps": total}
         with _interrupt_after():
             checkpoint.save(cfg.run_dir, it, st, meta)

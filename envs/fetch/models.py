@@ -116,6 +116,7 @@ ARM_REACH_CENTER = {"slide": (0.319, 0.744, 0.781)}
 ARM_REACH_CENTER_DEFAULT = (0.674, 0.744, 0.781)
 ARM_STRETCH_GAIN = 0.10  # m^0.5 per control step: the target's outward step is capped at this * sqrt(R - r)
 WORKSPACES = ("arm", "box")
+TARGET_STEP = 0.05  # metres of gripper target motion per unit action per control step
 
 
 def within_reach(grip, target, center, radius=ARM_REACH_RADIUS, stretch_gain=ARM_STRETCH_GAIN, xp=np):
@@ -132,6 +133,27 @@ def within_reach(grip, target, center, radius=ARM_REACH_RADIUS, stretch_gain=ARM
     off = target - center
     dist = xp.sqrt(xp.sum(off * off, axis=-1, keepdims=True))
     return center + off * xp.minimum(1.0, radius / xp.maximum(dist, 1e-9))
+
+
+def workspace_box(kind: str):
+    """World xyz (lo, hi) of the box the gripper target is clipped to: the table and 15 cm around it in
+    xy, from the fingertips on the table top to 0.6 m above it."""
+    (tx, ty, _), (hx, hy, _), _ = _SCENES[kind]
+    margin = 0.15
+    return ((tx - hx - margin, ty - hy - margin, TABLE_TOP + FINGER_BELOW_SITE),
+            (tx + hx + margin, ty + hy + margin, TABLE_TOP + 0.6))
+
+
+def gripper_target(q, action_xyz, home, lo, hi, reach_center=None, stretch_gain=ARM_STRETCH_GAIN, xp=np):
+    """The xyz drive's next target in the gripper joints' coordinates (grip site = ``home`` + ``q``), as
+    each control step sets it: ``TARGET_STEP * action_xyz`` from where the gripper is, clipped to the
+    world box [``lo``, ``hi``], then kept within the reference arm's reach around ``reach_center``
+    (``within_reach``) unless that is None. The one rule of the tasks and of the C replicas."""
+    home = xp.asarray(home)
+    target = xp.clip(q + TARGET_STEP * action_xyz, xp.asarray(lo) - home, xp.asarray(hi) - home)
+    if reach_center is not None:
+        target = within_reach(q + home, target + home, reach_center, stretch_gain=stretch_gain, xp=xp) - home
+    return target
 
 
 TABLES = ("plane", "box")
@@ -161,8 +183,7 @@ class Layout:
     grip_home: tuple[float, float, float]  # grip-site position when the gripper joints are 0
     workspace_lo: tuple[float, float, float]  # clip box of the grip-site target
     workspace_hi: tuple[float, float, float]
-    reach_center: tuple[float, float, float]  # the reference arm's reach ball (ARM_REACH_*)
-    reach_radius: float
+    reach_center: tuple[float, float, float]  # centre of the reference arm's reach (ARM_REACH_*)
     object_rest_z: float | None  # object centre height at rest on the table
     nq: int
     nv: int
@@ -348,10 +369,8 @@ def build(kind: str, **options):
     finger_v = int(jnt("finger_l").dofadr[0]) if free_fingers else None
     object_q = int(jnt("object").qposadr[0]) if kind != "reach" else None
     object_v = int(jnt("object").dofadr[0]) if kind != "reach" else None
-    (tx, ty, _), (hx, hy, _), home = _SCENES[kind]
-    margin = 0.15
-    lo = (tx - hx - margin, ty - hy - margin, TABLE_TOP + FINGER_BELOW_SITE)
-    hi = (tx + hx + margin, ty + hy + margin, TABLE_TOP + 0.6)
+    home = _SCENES[kind][2]
+    lo, hi = workspace_box(kind)
     rest_z = _rest_height(m, object_q) if object_q is not None else None
     layout = Layout(
         grip_q=grip_q,
@@ -363,7 +382,6 @@ def build(kind: str, **options):
         workspace_lo=lo,
         workspace_hi=hi,
         reach_center=ARM_REACH_CENTER.get(kind, ARM_REACH_CENTER_DEFAULT),
-        reach_radius=ARM_REACH_RADIUS,
         object_rest_z=rest_z,
         nq=int(m.nq),
         nv=int(m.nv),

@@ -299,13 +299,10 @@ class _FetchTask(GoalEnv):
     # ---- step --------------------------------------------------------------------------------
     def _control(self, phys: Physics, action: jax.Array) -> jax.Array:
         lay = self.layout
-        home = jnp.asarray(lay.grip_home)
         g = lay.grip_q
-        target = phys.qpos[g : g + 3] + 0.05 * action[:3]
-        target = jnp.clip(target, jnp.asarray(lay.workspace_lo) - home, jnp.asarray(lay.workspace_hi) - home)
-        if self.workspace == "arm":
-            grip = phys.qpos[g : g + 3] + home
-            target = models.within_reach(grip, target + home, lay.reach_center, lay.reach_radius, xp=jnp) - home
+        reach = lay.reach_center if self.workspace == "arm" else None
+        target = models.gripper_target(phys.qpos[g : g + 3], action[:3], lay.grip_home, lay.workspace_lo,
+                                       lay.workspace_hi, reach, xp=jnp)  # fmt: skip
         ctrl = phys.ctrl.at[0:3].set(target)
         if lay.finger_q is not None:
             f = lay.finger_q

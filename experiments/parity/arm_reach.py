@@ -104,7 +104,6 @@ def run_ours(stretch_gain=None) -> dict:
         lay = models.build(kind, timestep=0.004, iterations=10, ls_iterations=4)[2]
         home = np.asarray(lay.grip_home)
         g, site = lay.grip_q, m.site("grip").id
-        lo, hi = np.asarray(lay.workspace_lo) - home, np.asarray(lay.workspace_hi) - home
         d = mujoco.MjData(m)
         mujoco.mj_forward(m, d)
         start = d.site_xpos[site].copy()
@@ -117,9 +116,8 @@ def run_ours(stretch_gain=None) -> dict:
             path = []
             for _ in range(STEPS):
                 a = np.clip((tgt - d.site_xpos[site]) / 0.05, -1, 1)
-                target = np.clip(d.qpos[g : g + 3] + 0.05 * a, lo, hi)
-                grip = home + d.qpos[g : g + 3]
-                d.ctrl[0:3] = models.within_reach(grip, home + target, lay.reach_center, lay.reach_radius, gain) - home
+                d.ctrl[0:3] = models.gripper_target(d.qpos[g : g + 3], a, home, lay.workspace_lo, lay.workspace_hi,
+                                                    lay.reach_center, gain)
                 for _ in range(10):
                     mujoco.mj_step(m, d)
                 path.append(d.site_xpos[site].copy())

@@ -23,10 +23,12 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(1, str(Path(__file__).resolve().parent))
 
 import jax  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
+from run_reference import parse_pairs  # noqa: E402  (its helpers need no reference packages)
 
 TASKS = ("push", "slide", "pick_and_place", "reach")
 
@@ -98,11 +100,6 @@ def run_task(task: str, episodes: int, seed: int, overrides: dict | None = None,
     }
 
 
-def _pairs(items) -> dict:
-    """``["a=1", "b=\"x\""]`` -> ``{"a": 1, "b": "x"}`` (values as JSON)."""
-    return {k: json.loads(v) for k, _, v in (item.partition("=") for item in items)}
-
-
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--tasks", default=",".join(TASKS))
@@ -114,8 +111,8 @@ def main(argv=None) -> int:
     p.add_argument("--controller", action="append", default=[], metavar="ARG=VALUE",
                    help="keyword argument of the scripted controllers, e.g. --controller aim_short=0.08 (repeatable)")
     args = p.parse_args(argv)
-    overrides = _pairs(args.set)
-    controller_kwargs = _pairs(args.controller)
+    overrides = parse_pairs(args.set)
+    controller_kwargs = parse_pairs(args.controller)
 
     import mujoco
 

@@ -120,6 +120,11 @@ def bench(env_id: str, steps: int, procs: int) -> dict:
     }
 
 
+def parse_pairs(items) -> dict:
+    """``["a=1", 'b="x"']`` -> ``{"a": 1, "b": "x"}``: command-line ``KEY=VALUE`` items, values as JSON."""
+    return {k: json.loads(v) for k, _, v in (item.partition("=") for item in items)}
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--tasks", default="push,slide,pick_and_place,reach")
@@ -132,7 +137,7 @@ def main(argv=None) -> int:
     p.add_argument("--controller", action="append", default=[], metavar="ARG=VALUE",
                    help="keyword argument of the scripted controllers, e.g. --controller aim_short=0.08 (repeatable)")
     args = p.parse_args(argv)
-    controller_kwargs = {k: json.loads(v) for k, _, v in (item.partition("=") for item in args.controller)}
+    controller_kwargs = parse_pairs(args.controller)
 
     import gymnasium_robotics
     import mujoco

@@ -63,12 +63,10 @@ def run(
     g = int(m.joint("grip_x").qposadr[0])
     o = int(m.joint("object").qposadr[0])
     ov = int(m.joint("object").dofadr[0])
-    (tx, ty, _), (hx, hy, _), home = models._SCENES["slide"]
-    home = np.asarray(home)
-    lo = np.array([tx - hx - 0.15, ty - hy - 0.15, models.TABLE_TOP + models.FINGER_BELOW_SITE]) - home
-    hi = np.array([tx + hx + 0.15, ty + hy + 0.15, models.TABLE_TOP + 0.6]) - home
+    home = np.asarray(models._SCENES["slide"][2])
+    lo, hi = models.workspace_box("slide")
     rest_z = models._rest_height(m, o)
-    reach_center = models.ARM_REACH_CENTER["slide"]
+    reach_center = models.ARM_REACH_CENTER["slide"] if workspace == "arm" else None
     obj_xy, goal_xy = starts(episodes, seed) if ep_starts is None else ep_starts
     goal = np.concatenate([goal_xy, np.full((episodes, 1), rest_z)], axis=1)
     ds = []
@@ -102,10 +100,7 @@ def run(
         for i, d in enumerate(ds):
             if bad[i]:
                 continue
-            target = np.clip(d.qpos[g : g + 3] + 0.05 * act[i, :3], lo, hi)
-            if workspace == "arm":
-                target = models.within_reach(home + d.qpos[g : g + 3], home + target, reach_center) - home
-            d.ctrl[0:3] = target
+            d.ctrl[0:3] = models.gripper_target(d.qpos[g : g + 3], act[i, :3], home, lo, hi, reach_center)
             for _ in range(substeps):
                 mujoco.mj_step(m, d)
                 if on_substep is not None:
