@@ -93,7 +93,7 @@ def run_reference() -> dict:
 
 
 def run_ours(stretch_gain=None) -> dict:
-    """Our model and control rule (``tasks._FetchTask._control``) in MuJoCo C, 10 steps of 4 ms each;
+    """Our model and control rule (``models.gripper_target``, as the tasks step) in MuJoCo C, 10 steps of 4 ms each;
     ``stretch_gain`` overrides ``models.ARM_STRETCH_GAIN``."""
     from envs.fetch import models
 
