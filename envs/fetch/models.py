@@ -116,6 +116,9 @@ ARM_REACH_CENTER = {"slide": (0.319, 0.744, 0.781)}
 ARM_REACH_CENTER_DEFAULT = (0.674, 0.744, 0.781)
 ARM_STRETCH_GAIN = 0.10  # m^0.5 per control step: the target's outward step is capped at this * sqrt(R - r)
 WORKSPACES = ("arm", "box")
+DRIVES = ("pd", "weld")
+WELD_SOLREF = "0.02 1"  # the reference's mocap weld: time constant, damping ratio
+WELD_SOLIMP = "0.9 0.95 0.001 0.5 2"
 TARGET_STEP = 0.05  # metres of gripper target motion per unit action per control step
 
 
@@ -206,6 +209,7 @@ def mjcf(
     drive_omega: float = DRIVE_OMEGA,
     drive_damping_ratio: float = 1.0,
     drive_damping: str = "joint",
+    drive: str = "pd",
 ) -> str:
     """The MJCF text of task ``kind`` (one of ``KINDS``); ``table`` is the table's collision shape
     (``tables_for(kind)``), ``finger`` the closed finger block's (``fingers_for(kind)``).
@@ -214,7 +218,13 @@ def mjcf(
     drive (kp = m w^2, damping 2 z m w) for sensitivity studies (``experiments/parity/slide_strike.py``).
     ``drive_damping`` is where that damping acts: ``"joint"`` (default) as joint damping, which the Euler
     integrator treats implicitly; ``"actuator"`` as the actuators' velocity feedback, explicit like the
-    damping term of the reference weld's reference acceleration."""
+    damping term of the reference weld's reference acceleration.
+
+    ``drive="weld"`` holds the gripper to a mocap body ``target`` (the grip site's world target) by a
+    connect constraint with the reference weld's solref and solimp (``WELD_SOLREF``, ``WELD_SOLIMP``)
+    instead of the PD drive: the reference's drive law on our gripper, for studies in MuJoCo C, which
+    set ``mocap_pos`` where the PD drive takes ``ctrl`` (``experiments/parity/slide_c.py``). The MJX
+    tasks use the PD drive."""
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
     if table not in tables_for(kind):
@@ -227,6 +237,8 @@ def mjcf(
             raise ValueError(f"{name} must be > 0, got {value}")
     if drive_damping not in ("joint", "actuator"):
         raise ValueError(f"drive_damping must be 'joint' or 'actuator', got {drive_damping!r}")
+    if drive not in DRIVES:
+        raise ValueError(f"drive must be one of {DRIVES}, got {drive!r}")
     (tx, ty, tz), (hx, hy, hz), (gx, gy, gz) = _SCENES[kind]
     has_object = kind != "reach"
     free_fingers = kind == "pick_and_place"
@@ -235,6 +247,13 @@ def mjcf(
     w = drive_omega
     kp, kv = mass * w * w, 2.0 * drive_damping_ratio * mass * w
     joint_kv, bias_kv = (f"{kv:.6g}", "0") if drive_damping == "joint" else ("0", f"{-kv:.6g}")
+    weld = ""
+    if drive == "weld":  # no PD forces (the z actuator keeps only the gravity bias); a constraint pulls instead
+        kp, joint_kv, bias_kv = 0.0, "0", "0"
+        weld = f"""
+  <equality>
+    <connect body1="gripper" body2="target" anchor="0 0 0" solref="{WELD_SOLREF}" solimp="{WELD_SOLIMP}"/>
+  </equality>"""
     obj_half = (OBJECT_HALF, OBJECT_HALF, PUCK_HALF_HEIGHT if slide else OBJECT_HALF)
     rest_z = TABLE_TOP + obj_half[2]
     ox, oy = gx + 0.1, gy + 0.1  # any spot on the table; reset moves it
@@ -332,8 +351,8 @@ def mjcf(
       <site name="grip" pos="0 0 0" size="0.005"/>
       <geom name="palm" type="box" size="0.02 0.04 0.01" pos="0 0 0.062" mass="{palm_mass:.6g}" {nograv}
             rgba="0.3 0.3 0.3 1"/>{fingers}
-    </body>{obj}
-  </worldbody>
+    </body>{obj}{'<body name="target" mocap="true" pos="' + _fmt(gx, gy, gz) + '"/>' if weld else ""}
+  </worldbody>{weld}
   <contact>{obj_pairs}{finger_pairs}
   </contact>
   <actuator>

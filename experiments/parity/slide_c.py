@@ -101,6 +101,8 @@ def run(
             if bad[i]:
                 continue
             d.ctrl[0:3] = models.gripper_target(d.qpos[g : g + 3], act[i, :3], home, lo, hi, reach_center)
+            if m.nmocap:  # drive="weld": the constraint pulls the gripper to the mocap target
+                d.mocap_pos[0] = home + d.ctrl[0:3]
             for _ in range(substeps):
                 mujoco.mj_step(m, d)
                 if on_substep is not None:

@@ -22,6 +22,11 @@ target jumps 4.5 cm ahead of a gripper that was closing in at 0.2 m/s (the puck 
         --out experiments/parity/results/strike_ours.json
     # ours under other drives and gripper masses (each a model option of ``envs.fetch.models.mjcf``)
     python experiments/parity/slide_strike.py --side ours --grid --out experiments/parity/results/strike_grid.json
+    # ours under the reference's drive law (a weld-like constraint to a mocap target), at 4 ms and at 2 ms
+    python experiments/parity/slide_strike.py --side ours --drive weld \
+        --out experiments/parity/results/strike_ours_weld_4ms.json
+    python experiments/parity/slide_strike.py --side ours --drive weld --timestep 0.002 --substeps 20 \
+        --out experiments/parity/results/strike_ours_weld_2ms.json
     # side by side, as markdown
     python experiments/parity/slide_strike.py --summary experiments/parity/results/strike_reference.json \\
         experiments/parity/results/strike_ours.json
@@ -182,11 +187,14 @@ def run_ours(
     every = round(0.004 / timestep)
     for a in RESPONSE_ACTIONS:
         d.ctrl[0:3] = d.qpos[g : g + 3] + 0.05 * np.asarray(a)
+        if m.nmocap:
+            d.mocap_pos[0] = np.asarray(models._SCENES["slide"][2]) + d.ctrl[0:3]
         for k in range(substeps):
             mujoco.mj_step(m, d)
             if (k + 1) % every == 0:
                 speeds.append(float(d.qvel[g]))
-    return _result("ours", records, speeds, {"mujoco": mujoco.__version__, "model_options": model_options})
+    return _result("ours", records, speeds, {"mujoco": mujoco.__version__, "model_options": model_options,
+                                            "timestep": timestep, "substeps": substeps})
 
 
 def _record(any_success, final_success, want, rec, along, across):
@@ -325,6 +333,10 @@ def main(argv=None) -> int:
     p.add_argument("--gripper-mass", type=float, help="ours: gripper mass, kg (default 13)")
     p.add_argument("--drive-damping", choices=("joint", "actuator"),
                    help="ours: the drive's damping as implicit joint damping (default) or explicit actuator feedback")
+    p.add_argument("--drive", choices=("pd", "weld"),
+                   help="ours: the PD drive (default) or the reference's weld law, a constraint to a mocap target")
+    p.add_argument("--timestep", type=float, default=0.004, help="ours: MuJoCo timestep, s (the reference: 0.002)")
+    p.add_argument("--substeps", type=int, default=10, help="ours: MuJoCo steps per 0.04 s control step")
     p.add_argument("--grid", action="store_true", help="ours: every drive in GRID_DRIVES, then every GRID_MASSES")
     p.add_argument("--reference-json", help="with --grid: a --side reference run, to score each drive against")
     p.add_argument("--out", help="JSON file for the run")
@@ -345,7 +357,8 @@ def main(argv=None) -> int:
     if args.side is None:
         p.error("--side is required unless --summary is given")
     if args.side == "reference":
-        if args.grid or args.drive_omega or args.drive_damping_ratio or args.gripper_mass or args.drive_damping:
+        if (args.grid or args.drive_omega or args.drive_damping_ratio or args.gripper_mass or args.drive_damping
+                or args.drive):
             p.error("--grid and the model options are for --side ours")
         result = run_reference(args.episodes, args.seed)
     elif args.grid:
@@ -371,9 +384,12 @@ def main(argv=None) -> int:
             print("identified drive:", result["identified"])
     else:
         opts = {k: v for k, v in (("drive_omega", args.drive_omega), ("drive_damping_ratio", args.drive_damping_ratio),
-                                  ("gripper_mass", args.gripper_mass), ("drive_damping", args.drive_damping))
+                                  ("gripper_mass", args.gripper_mass), ("drive_damping", args.drive_damping),
+                                  ("drive", args.drive))
                 if v is not None}
-        result = run_ours(args.episodes, args.seed, **opts)
+        if abs(args.timestep * args.substeps - 0.04) > 1e-9:
+            p.error(f"--timestep x --substeps must be the 0.04 s control step, got {args.timestep * args.substeps:g}")
+        result = run_ours(args.episodes, args.seed, args.timestep, args.substeps, **opts)
     if "episodes" in result and isinstance(result["episodes"], list):
         print(summary([result]))
     if args.out:

@@ -278,9 +278,23 @@ def test_drive_options_set_how_fast_the_gripper_follows_and_reject_nonpositive_v
     # the same damping as the actuators' explicit velocity feedback lets the gripper start faster
     assert _grip_speed_after_jump(models.mjcf("slide", 0.004, 10, 4, drive_damping="actuator")) > 1.1 * base
     for field, bad in (("gripper_mass", 0.0), ("drive_omega", 0.0), ("drive_damping_ratio", 0.0),
-                       ("drive_damping", "tendon")):
+                       ("drive_damping", "tendon"), ("drive", "spring")):
         with pytest.raises(ValueError, match=field):
             models.mjcf("slide", **{field: bad})
+
+
+def test_weld_drive_pulls_the_gripper_onto_its_mocap_target():
+    m = mujoco.MjModel.from_xml_string(models.mjcf("slide", 0.002, 10, 4, drive="weld"))
+    d = mujoco.MjData(m)
+    g = m.joint("grip_x").qposadr[0]
+    d.ctrl[0:3] = [0.05, -0.03, 0.02]  # the PD drive's input: ignored by this drive
+    for _ in range(50):
+        mujoco.mj_step(m, d)
+    np.testing.assert_allclose(d.qpos[g : g + 3], 0.0, atol=1e-3)
+    d.mocap_pos[0] = np.asarray(models._SCENES["slide"][2]) + [0.05, -0.03, 0.02]
+    for _ in range(250):  # 0.5 s: ten time constants of the constraint
+        mujoco.mj_step(m, d)
+    np.testing.assert_allclose(d.qpos[g : g + 3], [0.05, -0.03, 0.02], atol=1e-3)
 
 
 # ---- physics: one compiled program per task --------------------------------------------------------
