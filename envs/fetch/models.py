@@ -20,6 +20,9 @@ mocap body 5,100 and 590 (compile 50 s): the weld adds 3 dofs and 6 constraint r
 target moved 5 cm ahead at every control step alike: the grip advances 3.0 cm in the first step,
 then 3.4 cm per step (weld: 3.2 cm), and stops within 0.2 mm of the target once it is held, so
 neither reaches the full 5 cm within one step, the reference's weld (same time constant) neither.
+The task field ``drive="weld"`` keeps the slide joints but pulls them with the reference's weld law
+instead (a connect constraint to a mocap body, 3 rows; see ``mjcf``); its cost on the GPU is in
+BENCHMARKS.md section 1.
 
 Reach. The reference's gripper hangs on a 7-joint arm, ours on none: the tasks keep each target
 within the arm's measured reach (``within_reach``, task field ``workspace``). Driven at full action
@@ -222,9 +225,9 @@ def mjcf(
 
     ``drive="weld"`` holds the gripper to a mocap body ``target`` (the grip site's world target) by a
     connect constraint with the reference weld's solref and solimp (``WELD_SOLREF``, ``WELD_SOLIMP``)
-    instead of the PD drive: the reference's drive law on our gripper, for studies in MuJoCo C, which
-    set ``mocap_pos`` where the PD drive takes ``ctrl`` (``experiments/parity/slide_c.py``). The MJX
-    tasks use the PD drive."""
+    instead of the PD drive: the reference's drive law on our gripper. Whoever steps the model puts the
+    mocap body at the grip site's target (the tasks' field ``drive``, ``experiments/parity/slide_c.py``);
+    ``ctrl[0:3]`` then moves nothing."""
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
     if table not in tables_for(kind):

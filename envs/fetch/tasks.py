@@ -116,6 +116,7 @@ class _FetchTask(GoalEnv):
     drive_omega: float = models.DRIVE_OMEGA  # rad/s: natural frequency of the gripper's xyz drive
     drive_damping_ratio: float = 1.0  # of the same drive (models.mjcf)
     workspace: str = "arm"  # where the gripper target may go: the box and the reference arm's reach, or the box
+    drive: str = "pd"  # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -140,6 +141,7 @@ class _FetchTask(GoalEnv):
         check(self.finger in fingers, f"{n}.finger", self.finger, "one of " + ", ".join(fingers))
         spaces = models.WORKSPACES
         check(self.workspace in spaces, f"{n}.workspace", self.workspace, "one of " + ", ".join(spaces))
+        check(self.drive in models.DRIVES, f"{n}.drive", self.drive, "one of " + ", ".join(models.DRIVES))
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
         check(10 <= self.drive_omega <= 200, f"{n}.drive_omega", self.drive_omega, "in [10, 200] rad/s")
         check(0.5 <= self.drive_damping_ratio <= 3, f"{n}.drive_damping_ratio", self.drive_damping_ratio, "in [0.5, 3]")
@@ -188,6 +190,7 @@ class _FetchTask(GoalEnv):
             finger=str(self.finger),
             drive_omega=float(self.drive_omega),
             drive_damping_ratio=float(self.drive_damping_ratio),
+            drive=str(self.drive),
         )
 
     @property
@@ -318,6 +321,9 @@ class _FetchTask(GoalEnv):
         data = mjx.make_data(model).replace(
             qpos=phys.qpos, qvel=phys.qvel, ctrl=ctrl, time=phys.time, qacc_warmstart=phys.qacc_warmstart
         )
+        if self.drive == "weld":  # the constraint pulls the gripper to the mocap body, put at the target
+            home = jnp.asarray(self.layout.grip_home, data.mocap_pos.dtype)
+            data = data.replace(mocap_pos=data.mocap_pos.at[0].set(home + ctrl[0:3]))
         with small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"):
             data = jax.lax.fori_loop(0, self.substeps, lambda _, d: mjx.step(model, d), data)
         return Physics(

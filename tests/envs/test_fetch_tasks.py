@@ -148,6 +148,7 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("slide", "drive_omega", 0.0),
         ("push", "drive_damping_ratio", 10.0),
         ("slide", "workspace", "sphere"),
+        ("push", "drive", "mocap"),
     ],
 )
 def test_bad_overrides_fail_naming_the_field(name, field, value):
@@ -366,6 +367,23 @@ def test_slide_gripper_driven_away_stops_on_the_arm_reach():
     dist = np.linalg.norm(grip - np.asarray(models.ARM_REACH_CENTER["slide"]), axis=1)
     np.testing.assert_allclose(dist, models.ARM_REACH_RADIUS, atol=0.01)
     assert grip[:, 0].max() < 1.41  # the reference's gripper reaches x 1.39 at table height
+
+
+@pytest.mark.slow
+def test_weld_drive_in_mjx_follows_the_target_like_the_pd_drive():
+    """The reference's weld law (a constraint to a mocap body that ``simulate`` puts at the target) moves
+    the gripper along the same path as the PD drive does, to within 3 mm."""
+    acts = jnp.asarray(np.broadcast_to(np.array([1.0, -0.5, 0.5, 0.0], np.float32), (6, 4)))
+    paths = []
+    for drive in ("pd", "weld"):
+        env = envs.make("reach", drive=drive)
+        run = jax.jit(lambda s, a, env=env: jax.lax.scan(lambda s, a: (env.step(s, a),) * 2, s, a)[1])
+        traj = run(env.reset(jax.random.PRNGKey(0)), acts)
+        paths.append(np.asarray(traj.obs)[:, 0:3])
+    pd, weld = paths
+    steps = np.linalg.norm(np.diff(pd, axis=0), axis=1)
+    assert steps.min() > 0.025  # both move 3 to 5 cm per step at full action
+    np.testing.assert_allclose(weld, pd, atol=0.003)
 
 
 @pytest.mark.slow
