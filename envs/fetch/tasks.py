@@ -10,7 +10,8 @@ each control step sets the xyz target to the *current* grip position plus ``0.05
 to a workspace box whose floor keeps the fingertips at or above the table top, then within the
 reference arm's reach (``models.within_reach``: the gripper slows as it nears the arm's reach and
 stops on its sphere, as the reference's does; ``workspace="box"`` drops this). The target is the
-actuator control, which ``Physics`` holds, so nothing else needs saving.
+actuator control, which ``Physics`` holds, so nothing else needs saving. With ``drive="weld"`` (Slide's
+default) a constraint pulls the gripper to a mocap body that ``simulate`` puts at that target.
 
 ``State.physics`` (a ``Physics``) is the complete simulator state: qpos, qvel, ctrl, time and the
 Newton solver's warm start. ``step`` rebuilds an ``mjx.Data`` from it, so restoring a saved ``State``
@@ -145,6 +146,10 @@ class _FetchTask(GoalEnv):
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
         check(10 <= self.drive_omega <= 200, f"{n}.drive_omega", self.drive_omega, "in [10, 200] rad/s")
         check(0.5 <= self.drive_damping_ratio <= 3, f"{n}.drive_damping_ratio", self.drive_damping_ratio, "in [0.5, 3]")
+        for field in ("drive_omega", "drive_damping_ratio"):  # the PD drive's gains; the weld law has its own
+            default = _FetchTask.__dataclass_fields__[field].default
+            check(self.drive == "pd" or getattr(self, field) == default, f"{n}.{field}", getattr(self, field),
+                  f"{default} (the default) with drive='weld': it sets the PD drive")
         check(
             isinstance(self.max_episode_steps, int) and self.max_episode_steps >= 1,
             f"{n}.max_episode_steps",
@@ -370,6 +375,7 @@ class Slide(_FetchTask):
     obj_range: float = 0.1
     target_range: float = 0.3
     iterations: int = 10  # 4 let a resting low-friction puck creep in float32 (up to 10 cm in 50 steps)
+    drive: str = "weld"  # the reference's drive law: its launches are the reference's (models.py, "Slide")
     kind = "slide"
     target_offset = (0.4, 0.0, 0.0)
 

@@ -149,6 +149,7 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("push", "drive_damping_ratio", 10.0),
         ("slide", "workspace", "sphere"),
         ("push", "drive", "mocap"),
+        ("slide", "drive_omega", 55.0),  # a PD gain, while Slide's default drive is the weld law
     ],
 )
 def test_bad_overrides_fail_naming_the_field(name, field, value):
