@@ -67,13 +67,13 @@ with a plane, a sphere, a capsule or a cylinder, not with a box, so:
   slower and stopped short (MuJoCo C replica, ``experiments/parity/slide_c.py``, 200 episodes:
   23.5 % of them more than 5 cm short and 76.5 % success, against 2.5 % and 97.5 % at 13 kg).
 
-- the drive is the reference's weld law (task field ``drive="weld"``, Slide's default; ``mjcf``'s
-  ``drive``). Under the PD drive the puck left at 0.967 +- 0.015 of the controller's wanted speed, the
-  reference's at 0.991 +- 0.021, so ours never glided past the goal and its final-step success stood
-  7 to 9 points above the reference's; under the weld law 0.980 +- 0.028, with the grip's speed at
-  contact and the puck's speed over it nearer the reference's too (MuJoCo C replica, 200 episodes,
-  ``experiments/parity/slide_strike.py``). It costs 11 % of Slide's GPU throughput (BENCHMARKS.md
-  section 1).
+- the drive stays the PD drive. The reference's weld law (task field ``drive="weld"``; ``mjcf``'s
+  ``drive``) launches the struck puck nearer the reference's speed and spread at our 4 ms (0.980 +-
+  0.028 of the controller's wanted speed, the reference's 0.991 +- 0.021, PD's 0.967 +- 0.015; MuJoCo
+  C replica, 200 episodes, ``experiments/parity/slide_strike.py``), but not at the reference's own
+  2 ms (0.967 +- 0.013), so that agreement is not the reference's mechanism; SPLID learns Slide less
+  under it, and it costs 11 % of Slide's GPU throughput (``experiments/parity/README.md``, "Slide's
+  strike, measured"; BENCHMARKS.md sections 1 and 3).
 
 The earlier Slide model (a box puck of the same size on the box table, struck by the box finger
 block) tipped and spun the puck and launched it off the aimed line: 62.5 % any-step success against

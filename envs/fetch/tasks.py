@@ -10,8 +10,8 @@ each control step sets the xyz target to the *current* grip position plus ``0.05
 to a workspace box whose floor keeps the fingertips at or above the table top, then within the
 reference arm's reach (``models.within_reach``: the gripper slows as it nears the arm's reach and
 stops on its sphere, as the reference's does; ``workspace="box"`` drops this). The target is the
-actuator control, which ``Physics`` holds, so nothing else needs saving. With ``drive="weld"`` (Slide's
-default) a constraint pulls the gripper to a mocap body that ``simulate`` puts at that target.
+actuator control, which ``Physics`` holds, so nothing else needs saving. With ``drive="weld"`` a
+constraint pulls the gripper to a mocap body that ``simulate`` puts at that target instead.
 
 ``State.physics`` (a ``Physics``) is the complete simulator state: qpos, qvel, ctrl, time and the
 Newton solver's warm start. ``step`` rebuilds an ``mjx.Data`` from it, so restoring a saved ``State``
@@ -375,7 +375,6 @@ class Slide(_FetchTask):
     obj_range: float = 0.1
     target_range: float = 0.3
     iterations: int = 10  # 4 let a resting low-friction puck creep in float32 (up to 10 cm in 50 steps)
-    drive: str = "weld"  # the reference's drive law: its launches are the reference's (models.py, "Slide")
     kind = "slide"
     target_offset = (0.4, 0.0, 0.0)
 

@@ -149,12 +149,17 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("push", "drive_damping_ratio", 10.0),
         ("slide", "workspace", "sphere"),
         ("push", "drive", "mocap"),
-        ("slide", "drive_omega", 55.0),  # a PD gain, while Slide's default drive is the weld law
     ],
 )
 def test_bad_overrides_fail_naming_the_field(name, field, value):
     with pytest.raises(InvalidConfig, match=rf"{name}\.{field}"):
         envs.make(name, **{field: value})
+
+
+def test_pd_gains_with_the_weld_drive_fail_naming_the_gain():
+    with pytest.raises(InvalidConfig, match=r"slide\.drive_omega"):
+        envs.make("slide", drive="weld", drive_omega=55.0)
+    assert envs.make("slide", drive="pd", drive_omega=55.0).drive_omega == 55.0
 
 
 def _target_after(env, grip_world, action):
