@@ -378,7 +378,8 @@ def test_slide_gripper_driven_away_stops_on_the_arm_reach():
 @pytest.mark.slow
 def test_weld_drive_in_mjx_follows_the_target_like_the_pd_drive():
     """The reference's weld law (a constraint to a mocap body that ``simulate`` puts at the target) moves
-    the gripper along the same path as the PD drive does, to within 3 mm."""
+    the gripper along the same path as the PD drive does, to within 3 mm; a restored state replays
+    bit for bit under it too (the mocap body follows the saved control)."""
     acts = jnp.asarray(np.broadcast_to(np.array([1.0, -0.5, 0.5, 0.0], np.float32), (6, 4)))
     paths = []
     for drive in ("pd", "weld"):
@@ -386,6 +387,8 @@ def test_weld_drive_in_mjx_follows_the_target_like_the_pd_drive():
         run = jax.jit(lambda s, a, env=env: jax.lax.scan(lambda s, a: (env.step(s, a),) * 2, s, a)[1])
         traj = run(env.reset(jax.random.PRNGKey(0)), acts)
         paths.append(np.asarray(traj.obs)[:, 0:3])
+    replay = run(jax.tree.map(lambda x: x[2], traj), acts)  # from the state after step 3: steps 4 to 6
+    np.testing.assert_array_equal(np.asarray(replay.obs)[:3], np.asarray(traj.obs)[3:])
     pd, weld = paths
     steps = np.linalg.norm(np.diff(pd, axis=0), axis=1)
     assert steps.min() > 0.025  # both move 3 to 5 cm per step at full action
