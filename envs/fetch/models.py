@@ -258,9 +258,10 @@ def mjcf(
     w = drive_omega
     kp, kv = mass * w * w, 2.0 * drive_damping_ratio * mass * w
     joint_kv, bias_kv = (f"{kv:.6g}", "0") if drive_damping == "joint" else ("0", f"{-kv:.6g}")
-    weld = ""
+    weld = target_body = ""
     if drive == "weld":  # no PD forces (the z actuator keeps only the gravity bias); a constraint pulls instead
         kp, joint_kv, bias_kv = 0.0, "0", "0"
+        target_body = f'<body name="target" mocap="true" pos="{_fmt(gx, gy, gz)}"/>'
         weld = f"""
   <equality>
     <connect body1="gripper" body2="target" anchor="0 0 0" solref="{WELD_SOLREF}" solimp="{WELD_SOLIMP}"/>
@@ -362,7 +363,7 @@ def mjcf(
       <site name="grip" pos="0 0 0" size="0.005"/>
       <geom name="palm" type="box" size="0.02 0.04 0.01" pos="0 0 0.062" mass="{palm_mass:.6g}" {nograv}
             rgba="0.3 0.3 0.3 1"/>{fingers}
-    </body>{obj}{'<body name="target" mocap="true" pos="' + _fmt(gx, gy, gz) + '"/>' if weld else ""}
+    </body>{obj}{target_body}
   </worldbody>{weld}
   <contact>{obj_pairs}{finger_pairs}
   </contact>

@@ -185,10 +185,11 @@ def run_ours(
     mujoco.mj_forward(m, d)
     speeds = []
     every = round(0.004 / timestep)
+    home = np.asarray(models._SCENES["slide"][2])
     for a in RESPONSE_ACTIONS:
         d.ctrl[0:3] = d.qpos[g : g + 3] + 0.05 * np.asarray(a)
-        if m.nmocap:
-            d.mocap_pos[0] = np.asarray(models._SCENES["slide"][2]) + d.ctrl[0:3]
+        if m.nmocap:  # drive="weld": the constraint pulls the gripper to the mocap target
+            d.mocap_pos[0] = home + d.ctrl[0:3]
         for k in range(substeps):
             mujoco.mj_step(m, d)
             if (k + 1) % every == 0:
