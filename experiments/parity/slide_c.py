@@ -63,6 +63,8 @@ def run(
     g = int(m.joint("grip_x").qposadr[0])
     o = int(m.joint("object").qposadr[0])
     ov = int(m.joint("object").dofadr[0])
+    site = m.site("grip").id
+    jac = np.zeros((3, m.nv))
     home = np.asarray(models._SCENES["slide"][2])
     lo, hi = models.workspace_box("slide")
     rest_z = models._rest_height(m, o)
@@ -87,9 +89,11 @@ def run(
     for t in range(steps + 1):
         obs = np.zeros((episodes, 25), np.float32)
         for i, d in enumerate(ds):
-            grip = home + d.qpos[g : g + 3]
+            mujoco.mj_kinematics(m, d)  # the grip site where the step left it (a hinged hand may turn)
+            mujoco.mj_jacSite(m, d, jac, None, site)
+            grip = d.site_xpos[site].copy()
             obj = d.qpos[o : o + 3]
-            gv = d.qvel[g : g + 3] * dt
+            gv = (jac @ d.qvel) * dt
             obs[i, 0:3], obs[i, 3:6], obs[i, 6:9] = grip, obj, obj - grip
             obs[i, 14:17] = d.qvel[ov : ov + 3] * dt - gv
             obs[i, 20:23] = gv

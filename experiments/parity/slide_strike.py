@@ -27,6 +27,10 @@ target jumps 4.5 cm ahead of a gripper that was closing in at 0.2 m/s (the puck 
         --out experiments/parity/results/strike_ours_weld_4ms.json
     python experiments/parity/slide_strike.py --side ours --drive weld --timestep 0.002 --substeps 20 \
         --out experiments/parity/results/strike_ours_weld_2ms.json
+    # the reference with its arm's joint damping (or armature) scaled: how much its outcome owes to them
+    experiments/parity/.venv-ref/bin/python experiments/parity/slide_strike.py --side reference \
+        --episodes 1000 --arm-damping-scale 0.5 \\
+        --out experiments/parity/results/strike_reference_arm_damping0p5_1000.json
     # side by side, as markdown
     python experiments/parity/slide_strike.py --summary experiments/parity/results/strike_reference.json \\
         experiments/parity/results/strike_ours.json
@@ -58,6 +62,8 @@ GRID_MASSES = (10.0, 16.0, 20.0)  # the default 13 kg is the default drive's row
 # envs.fetch.models' Slide defaults, written out: this file also runs where envs cannot be imported
 DEFAULT_DRIVE = {"drive_omega": 50.0, "drive_damping_ratio": 1.0}
 DEFAULT_GRIPPER_MASS = 13.0
+ARM_JOINTS = ("shoulder_pan", "shoulder_lift", "upperarm_roll", "elbow_flex", "forearm_roll", "wrist_flex",
+              "wrist_roll")
 
 
 class Recorder:
@@ -98,8 +104,10 @@ def _landing(start_xy, goal_xy, final_xy):
     return float(disp @ d / n - n), float(abs(disp[0] * d[1] - disp[1] * d[0]) / n)
 
 
-def run_reference(episodes: int, seed: int) -> dict:
-    """FetchSlide-v4 (gymnasium-robotics, MuJoCo C) with the scripted slide; its own steps, hooked."""
+def run_reference(episodes: int, seed: int, arm_damping_scale: float = 1.0, arm_armature_scale: float = 1.0) -> dict:
+    """FetchSlide-v4 (gymnasium-robotics, MuJoCo C) with the scripted slide; its own steps, hooked.
+    The scales multiply the joint damping and armature of the arm's seven joints (``ARM_JOINTS``), to
+    measure how much the reference's own outcome depends on them."""
     import jax
     import run_reference as rr
 
@@ -108,6 +116,9 @@ def run_reference(episodes: int, seed: int) -> dict:
     env = rr.make_env("FetchSlide-v4")
     u_env = env.unwrapped
     m, d = u_env.model, u_env.data
+    arm = [int(m.joint(f"robot0:{j}_joint").dofadr[0]) for j in ARM_JOINTS]
+    m.dof_damping[arm] *= arm_damping_scale
+    m.dof_armature[arm] *= arm_armature_scale
     fingers = [m.geom(f"robot0:{s}_gripper_finger_link").id for s in ("l", "r")]
     puck, site = m.geom("object0").id, m.site("robot0:grip").id
     dof = int(m.joint("object0:joint").dofadr[0])
@@ -153,19 +164,26 @@ def run_reference(episodes: int, seed: int) -> dict:
         env.step(np.array([*a, 0.0]))
     import gymnasium_robotics
 
-    return _result("reference", records, speeds, {"gymnasium_robotics": gymnasium_robotics.__version__})
+    side = "reference"
+    if (arm_damping_scale, arm_armature_scale) != (1.0, 1.0):
+        side += f", arm damping x{arm_damping_scale:g}, armature x{arm_armature_scale:g}"
+    return _result(side, records, speeds, {"gymnasium_robotics": gymnasium_robotics.__version__,
+                                                  "arm_damping_scale": arm_damping_scale,
+                                                  "arm_armature_scale": arm_armature_scale})
 
 
 def run_ours(
-    episodes: int, seed: int, timestep: float = 0.004, substeps: int = 10, ep_starts=None, **model_options
+    episodes: int, seed: int, timestep: float = 0.004, substeps: int = 10, ep_starts=None, xml=None,
+    **model_options
 ) -> dict:
     """Our Slide MJCF in MuJoCo C through ``slide_c.run`` (our reset, control step and controller).
-    ``ep_starts`` (``slide_c.starts(episodes, seed)``) may be passed to reuse them across runs."""
+    ``ep_starts`` (``slide_c.starts(episodes, seed)``) may be passed to reuse them across runs; ``xml``
+    replaces the MJCF (a variant of ours with the same names, e.g. ``slide_hand.py``'s)."""
     import slide_c
 
     from envs.fetch import models, scripted
 
-    xml = models.mjcf("slide", timestep, 10, 4, **model_options)
+    xml = xml or models.mjcf("slide", timestep, 10, 4, **model_options)
     m = mujoco.MjModel.from_xml_string(xml)
     fingers = [m.geom(f"tip_{i}").id for i in range(4)]
     puck, site, dof = m.geom("object").id, m.site("grip").id, int(m.joint("object").dofadr[0])
@@ -179,23 +197,35 @@ def run_ours(
         along, across = _landing(obj_xy[i], goal_xy[i], r["final"][i, :2])
         records.append(_record(bool(r["succ"][:, i].any()), bool(r["succ"][-1, i]), want, rec, along, across))
 
+    speeds = free_response(m, timestep, substeps)
+    return _result("ours", records, speeds, {"mujoco": mujoco.__version__, "model_options": model_options,
+                                            "timestep": timestep, "substeps": substeps})
+
+
+def free_response(m, timestep: float, substeps: int) -> list[float]:
+    """Our grip site's x speed every 4 ms under ``RESPONSE_ACTIONS``, the puck moved out of reach."""
+    from envs.fetch import models
+
+    m.opt.timestep = timestep
     d = mujoco.MjData(m)
-    g, q = int(m.joint("grip_x").qposadr[0]), int(m.joint("object").qposadr[0])
+    g, q, site = int(m.joint("grip_x").qposadr[0]), int(m.joint("object").qposadr[0]), m.site("grip").id
     d.qpos[q : q + 3] = [0.6, 0.35, 0.42]
     mujoco.mj_forward(m, d)
     speeds = []
     every = round(0.004 / timestep)
     home = np.asarray(models._SCENES["slide"][2])
+    jac = np.zeros((3, m.nv))
     for a in RESPONSE_ACTIONS:
         d.ctrl[0:3] = d.qpos[g : g + 3] + 0.05 * np.asarray(a)
         if m.nmocap:  # drive="weld": the constraint pulls the gripper to the mocap target
             d.mocap_pos[0] = home + d.ctrl[0:3]
         for k in range(substeps):
             mujoco.mj_step(m, d)
-            if (k + 1) % every == 0:
-                speeds.append(float(d.qvel[g]))
-    return _result("ours", records, speeds, {"mujoco": mujoco.__version__, "model_options": model_options,
-                                            "timestep": timestep, "substeps": substeps})
+            if (k + 1) % every == 0:  # the site's speed from the velocities after the step, as the reference's
+                mujoco.mj_kinematics(m, d)
+                mujoco.mj_jacSite(m, d, jac, None, site)
+                speeds.append(float(jac[0] @ d.qvel))
+    return speeds
 
 
 def _record(any_success, final_success, want, rec, along, across):
@@ -336,6 +366,10 @@ def main(argv=None) -> int:
                    help="ours: the drive's damping as implicit joint damping (default) or explicit actuator feedback")
     p.add_argument("--drive", choices=("pd", "weld"),
                    help="ours: the PD drive (default) or the reference's weld law, a constraint to a mocap target")
+    p.add_argument("--arm-damping-scale", type=float, default=1.0,
+                   help="reference: multiply the arm joints' damping by this (default 1: as shipped)")
+    p.add_argument("--arm-armature-scale", type=float, default=1.0,
+                   help="reference: multiply the arm joints' armature by this (default 1: as shipped)")
     p.add_argument("--timestep", type=float, default=0.004, help="ours: MuJoCo timestep, s (the reference: 0.002)")
     p.add_argument("--substeps", type=int, default=10, help="ours: MuJoCo steps per 0.04 s control step")
     p.add_argument("--grid", action="store_true", help="ours: every drive in GRID_DRIVES, then every GRID_MASSES")
@@ -357,11 +391,15 @@ def main(argv=None) -> int:
         return 0
     if args.side is None:
         p.error("--side is required unless --summary is given")
+    if args.side == "ours" and (args.arm_damping_scale != 1.0 or args.arm_armature_scale != 1.0):
+        p.error("--arm-damping-scale and --arm-armature-scale are for --side reference")
+    if not (args.arm_damping_scale >= 0 and args.arm_armature_scale >= 0):
+        p.error("--arm-damping-scale and --arm-armature-scale must be >= 0")
     if args.side == "reference":
         if (args.grid or args.drive_omega or args.drive_damping_ratio or args.gripper_mass or args.drive_damping
                 or args.drive):
             p.error("--grid and the model options are for --side ours")
-        result = run_reference(args.episodes, args.seed)
+        result = run_reference(args.episodes, args.seed, args.arm_damping_scale, args.arm_armature_scale)
     elif args.grid:
         runs = [dict(drive_omega=w, drive_damping_ratio=z) for w, z in GRID_DRIVES]
         runs += [dict(gripper_mass=mass) for mass in GRID_MASSES]
