@@ -75,6 +75,11 @@ with a plane, a sphere, a capsule or a cylinder, not with a box, so:
   under it, and it costs 11 % of Slide's GPU throughput (``experiments/parity/README.md``, "Slide's
   strike, measured"; BENCHMARKS.md sections 1 and 3).
 
+- what stays different is the arm. The reference's final-step success on Slide moves from 79.5 to
+  90.1 % when its arm's joint damping is scaled by 0 to 2 (1,000 episodes), and a hand on two hinges
+  fitted to the arm's inertia and damping at the grip site passes the puck on like the reference's but
+  launches it slower (``experiments/parity/slide_hand.py``; README there, first finding).
+
 The earlier Slide model (a box puck of the same size on the box table, struck by the box finger
 block) tipped and spun the puck and launched it off the aimed line: 62.5 % any-step success against
 the reference's 96.5 % (see ``experiments/parity/README.md``).
