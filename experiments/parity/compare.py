@@ -58,7 +58,8 @@ def success_table(ours, ref, tasks):
         o, r = ours["tasks"][t]["episodes"], ref["tasks"][t]["episodes"]
         ao, ar = rate(o, "success_any"), rate(r, "success_any")
         fo, fr = rate(o, "success_final"), rate(r, "success_final")
-        flag = "**> 5 pts**" if max(abs(ao - ar), abs(fo - fr)) > FLAG_POINTS else ""
+        over = [name for name, diff in (("any step", ao - ar), ("final step", fo - fr)) if abs(diff) > FLAG_POINTS]
+        flag = f"**{' and '.join(over)} > 5 pts**" if over else ""
         lines.append(
             f"| {t} | {len(o)} / {len(r)} | {ao:.1f} | {ar:.1f} | {ao - ar:+.1f} | {fo:.1f} | {fr:.1f} | "
             f"{fo - fr:+.1f} | {flag} |"
