@@ -38,11 +38,19 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(1, str(HERE.parents[1]))
 
-ARM_JOINTS = ("shoulder_pan", "shoulder_lift", "upperarm_roll", "elbow_flex", "forearm_roll", "wrist_flex",
-              "wrist_roll")
+from slide_strike import ARM_JOINTS  # noqa: E402
+
 HAND_MASS = 10.0  # kg below the x hinge (fingers and palm); must exceed Lambda's bound, see fit()
 RY_BODY_MASS = 1.0  # kg between the y and x hinges
 RY_BODY_INERTIA = 0.01  # kg m^2
+
+
+def _opspace(mass, jac, damping) -> tuple[np.ndarray, np.ndarray]:
+    """Lambda = (J M^-1 J^T)^-1 and the joint damping seen through J, C = Lambda J M^-1 D M^-1 J^T Lambda
+    (dynamically consistent: the joint rates of the least-inertia motion)."""
+    lam = np.linalg.inv(jac @ np.linalg.solve(mass, jac.T))
+    proj = lam @ jac @ np.linalg.inv(mass)
+    return lam, proj @ np.diag(damping) @ proj.T
 
 
 def measure() -> dict:
@@ -62,10 +70,7 @@ def measure() -> dict:
     mass = full[np.ix_(arm, arm)]
     jp, jr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
     mujoco.mj_jacSite(m, d, jp, jr, m.site("robot0:grip").id)
-    jac = np.vstack([jp, jr])[:, arm]
-    lam = np.linalg.inv(jac @ np.linalg.solve(mass, jac.T))
-    proj = lam @ jac @ np.linalg.inv(mass)  # dynamically consistent: joint rates of the least-inertia motion
-    damp = proj @ np.diag(m.dof_damping[arm]) @ proj.T
+    lam, damp = _opspace(mass, np.vstack([jp, jr])[:, arm], m.dof_damping[arm])
     return {"env": "FetchSlide-v4", "seed": 0, "gymnasium_robotics": gymnasium_robotics.__version__,
             "mujoco": mujoco.__version__, "rows": ["x", "y", "z", "rx", "ry", "rz"],
             "lambda": lam.tolist(), "damping": damp.tolist()}
@@ -162,17 +167,14 @@ def opspace(xml: str) -> tuple[np.ndarray, np.ndarray]:
     mass = full[np.ix_(dofs, dofs)]
     jp, jr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
     mujoco.mj_jacSite(m, d, jp, jr, m.site("grip").id)
-    jac = np.vstack([jp, jr])[:5][:, dofs]
-    lam = np.linalg.inv(jac @ np.linalg.solve(mass, jac.T))
-    proj = lam @ jac @ np.linalg.inv(mass)
-    return lam, proj @ np.diag(m.dof_damping[dofs]) @ proj.T
+    return _opspace(mass, np.vstack([jp, jr])[:5][:, dofs], m.dof_damping[dofs])
 
 
-def fit_error(measured: dict) -> float:
-    """Largest relative difference between the chain's (damping scale 1) and the measured (x, ry) and
-    (y, rx) blocks of Lambda and C."""
+def fit_error(measured: dict, params: dict) -> float:
+    """Largest relative difference between the chain of ``params`` (``fit(measured)``; damping scale 1)
+    and the measured (x, ry) and (y, rx) blocks of Lambda and C."""
     lam, c = np.asarray(measured["lambda"]), np.asarray(measured["damping"])
-    ours_lam, ours_c = opspace(hand_mjcf(fit(measured), 0.004, 1.0))
+    ours_lam, ours_c = opspace(hand_mjcf(params, 0.004, 1.0))
     err = 0.0
     for idx in ([0, 4], [1, 3]):
         for a, b in ((ours_lam, lam), (ours_c, c)):
@@ -213,7 +215,7 @@ def main(argv=None) -> int:
         result = {"timestep": args.timestep, "scores": []}
         for scale in (0.0, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0):
             m = mujoco.MjModel.from_xml_string(hand_mjcf(params, args.timestep, scale))
-            speeds = ss.free_response(m, args.timestep, substeps)
+            speeds = ss.free_response(m, substeps)
             rms = ss.response_rms({"response_speed": speeds[ss.RESPONSE_FROM_STEP * 10 :]}, ref)
             result["scores"].append({"damping_scale": scale, "response_rms": rms})
             print(f"damping x{scale:g}: free-space response RMS from the reference {rms:.4f} m/s", flush=True)
@@ -227,7 +229,7 @@ def main(argv=None) -> int:
         measured = json.loads(Path(args.fit).read_text())
         params = fit(measured)
         xml = hand_mjcf(params, args.timestep, args.damping_scale)
-        print(f"fitted blocks (x, ry), (y, rx): largest relative error {fit_error(measured):.2e}")
+        print(f"fitted blocks (x, ry), (y, rx): largest relative error {fit_error(measured, params):.2e}")
         result = ss.run_ours(args.episodes, args.seed, args.timestep, substeps, xml=xml)
         result["side"] = f"ours, turning hand, damping x{args.damping_scale:g}, {args.timestep * 1000:g} ms"
         result["versions"]["hand"] = params

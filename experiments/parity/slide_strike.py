@@ -197,22 +197,22 @@ def run_ours(
         along, across = _landing(obj_xy[i], goal_xy[i], r["final"][i, :2])
         records.append(_record(bool(r["succ"][:, i].any()), bool(r["succ"][-1, i]), want, rec, along, across))
 
-    speeds = free_response(m, timestep, substeps)
+    speeds = free_response(m, substeps)
     return _result("ours", records, speeds, {"mujoco": mujoco.__version__, "model_options": model_options,
                                             "timestep": timestep, "substeps": substeps})
 
 
-def free_response(m, timestep: float, substeps: int) -> list[float]:
-    """Our grip site's x speed every 4 ms under ``RESPONSE_ACTIONS``, the puck moved out of reach."""
+def free_response(m, substeps: int) -> list[float]:
+    """Our grip site's x speed every 4 ms under ``RESPONSE_ACTIONS`` (``substeps`` MuJoCo steps of the
+    model's timestep per control step), the puck moved out of reach."""
     from envs.fetch import models
 
-    m.opt.timestep = timestep
     d = mujoco.MjData(m)
     g, q, site = int(m.joint("grip_x").qposadr[0]), int(m.joint("object").qposadr[0]), m.site("grip").id
     d.qpos[q : q + 3] = [0.6, 0.35, 0.42]
     mujoco.mj_forward(m, d)
     speeds = []
-    every = round(0.004 / timestep)
+    every = round(0.004 / m.opt.timestep)
     home = np.asarray(models._SCENES["slide"][2])
     jac = np.zeros((3, m.nv))
     for a in RESPONSE_ACTIONS:
