@@ -50,9 +50,9 @@ def trained_policy(env, cfg: TrainConfig, iterations: int):
     """The policy after ``iterations`` SPLID iterations: its exploration moves the object, so SELECT
     sees the share of valid candidates it sees in training (an untrained policy rarely moves it)."""
     trainer = Trainer(env, cfg)
-    state, hyper = trainer.init(jax.random.PRNGKey(0)), trainer.hyper()
+    state, hyper, chunk = trainer.init(jax.random.PRNGKey(0)), trainer.hyper(), jax.jit(trainer.chunk)
     for _ in range(-(-iterations // cfg.eval_every)):  # whole chunks, at least one
-        state, metrics = trainer.chunk(state, hyper)
+        state, metrics = chunk(state, hyper)
     done = int(state.iteration)
     print(f"policy trained {done} iterations at N={cfg.num_envs}: eval success {metrics['eval_success']:.3f}")
     return state.policy
@@ -107,7 +107,7 @@ def bench_chunk(env, cfg: TrainConfig, seeds: int, repeats: int) -> dict:
     keys = jnp.stack([jax.random.PRNGKey(s) for s in range(seeds)])
     states = jax.vmap(trainer.init)(keys)
     hyper = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (seeds,)), trainer.hyper())
-    many, _ = timed(jax.jit(jax.vmap(trainer._chunk)), states, hyper, repeats=repeats)
+    many, _ = timed(jax.jit(jax.vmap(trainer.chunk)), states, hyper, repeats=repeats)
     return {
         "num_envs": cfg.num_envs,
         "iterations_per_chunk": cfg.eval_every,

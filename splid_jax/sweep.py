@@ -54,7 +54,7 @@ def run_sweep(cfg: TrainConfig, grid: list[Member], quiet: bool = False) -> list
         horizon=jnp.asarray([m.horizon for m in grid], jnp.int32),
     )
     state = jax.jit(jax.vmap(trainer.init))(keys)
-    chunk = jax.jit(jax.vmap(trainer._chunk))
+    chunk = jax.jit(jax.vmap(trainer.chunk))
     dirs = [os.path.join(cfg.run_dir, m.name) for m in grid]
     for d, m in zip(dirs, grid, strict=True):
         os.makedirs(d, exist_ok=True)

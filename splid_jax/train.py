@@ -76,6 +76,7 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
     checkpoint in ``cfg.run_dir`` when ``resume``."""
     env = env or make_env(cfg.env, **cfg.env_overrides())
     trainer = Trainer(env, cfg)
+    chunk = jax.jit(trainer.chunk)
     os.makedirs(cfg.run_dir, exist_ok=True)
     metrics_path = os.path.join(cfg.run_dir, "metrics.jsonl")
     state = trainer.init(jax.random.PRNGKey(cfg.seed))
@@ -110,7 +111,7 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
     try:
         while iteration < cfg.iterations:
             t0 = time.perf_counter()
-            new_state, metrics = trainer.chunk(state, hyper)
+            new_state, metrics = chunk(state, hyper)
             metrics = jax.device_get(metrics)
             chunk_s = time.perf_counter() - t0
             if not bool(metrics.pop("finite")):

@@ -37,7 +37,10 @@ class Hyper:
 
 
 class Trainer:
-    """Holds what is static (task, network, optimiser, shapes); all state flows through arguments."""
+    """SPLID as an ``algorithm.Algorithm``: holds what is static (task, network, optimiser, shapes);
+    all state flows through arguments."""
+
+    name = "splid"
 
     def __init__(self, env: GoalEnv, cfg: TrainConfig, max_horizon: int | None = None):
         cfg.check_env(env)
@@ -45,8 +48,6 @@ class Trainer:
         self.max_horizon = cfg.horizon if max_horizon is None else max_horizon
         self.policy = make_policy(env.obs_size, env.goal_size, env.action_size, cfg.hidden, cfg.normalise)
         self.optimiser = optax.adam(cfg.learning_rate)
-        self.traces = 0  # counts compilations of ``chunk``; tests check it stays at one
-        self.chunk = jax.jit(self._chunk)
 
     def hyper(self, sigma: float | None = None, horizon: int | None = None) -> Hyper:
         return Hyper(
@@ -98,8 +99,7 @@ class Trainer:
         )
         return new, metrics
 
-    def _chunk(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
-        self.traces += 1
+    def chunk(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
         ts, per_iter = jax.lax.scan(lambda s, _: self.iteration(s, hyper), ts, None, length=self.cfg.eval_every)
         key, k_eval = jax.random.split(ts.key)
         metrics = evaluate(self.env, self.policy, ts.policy, k_eval, self.cfg.eval_episodes)

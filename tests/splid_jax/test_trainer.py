@@ -14,13 +14,21 @@ CFG = dict(env="point", num_envs=16, iterations=40, eval_every=10, bc_steps=50, 
 
 @pytest.fixture(scope="module")
 def trainer():
-    return Trainer(envs.make("point"), TrainConfig(**CFG))
+    trainer = Trainer(envs.make("point"), TrainConfig(**CFG))
+    trainer.traces = 0
+
+    def counted(state, hyper):  # counts Python traces: one per compilation
+        trainer.traces += 1
+        return trainer.chunk(state, hyper)
+
+    trainer.jitted = jax.jit(counted)
+    return trainer
 
 
 def run_chunks(trainer, seed, chunks):
     state, out = trainer.init(jax.random.PRNGKey(seed)), []
     for _ in range(chunks):
-        state, metrics = trainer.chunk(state, trainer.hyper())
+        state, metrics = trainer.jitted(state, trainer.hyper())
         out.append({k: float(np.sum(v)) for k, v in jax.device_get(metrics).items()})  # select_steps: per iteration
     return state, out
 
@@ -73,8 +81,8 @@ def test_same_seed_same_metrics_different_seed_different(trainer, learned):
 def test_select_accepts_fewer_pairs_than_the_ablation(trainer, learned):
     ablation = Trainer(trainer.env, TrainConfig(**{**CFG, "select": False, "iterations": 10}))
     state = trainer.init(jax.random.PRNGKey(0))
-    _, with_select = trainer.chunk(state, trainer.hyper())
-    _, without = ablation.chunk(state, ablation.hyper())
+    _, with_select = trainer.jitted(state, trainer.hyper())
+    _, without = jax.jit(ablation.chunk)(state, ablation.hyper())
     assert int(without["select_accepted"]) == int(without["select_pairs"])
     assert int(with_select["select_accepted"]) < int(with_select["select_pairs"])
     assert int(with_select["select_accepted"]) < int(without["select_accepted"])
