@@ -18,16 +18,21 @@ CLIP_NORMALISED = 5.0  # normalised inputs are clipped here, as HER does, so out
 
 
 class MLP(nn.Module):
-    """Leaky-ReLU MLP with orthogonal init (as the reference code), linear mean output."""
+    """MLP with orthogonal init. Defaults: leaky-ReLU and a linear output (as SPLID's reference
+    code); HER's actor and critic use ReLU, and its actor a tanh output (as OpenAI Baselines)."""
 
     hidden: Sequence[int]
     action_size: int
+    activation: str = "leaky_relu"  # a flax.linen activation: "leaky_relu" or "relu"
+    tanh_output: bool = False
 
     @nn.compact
     def __call__(self, x: jax.Array) -> jax.Array:
+        act = getattr(nn, self.activation)
         for width in self.hidden:
-            x = nn.leaky_relu(nn.Dense(width, kernel_init=nn.initializers.orthogonal(jnp.sqrt(2.0)))(x))
-        return nn.Dense(self.action_size, kernel_init=nn.initializers.orthogonal(0.01))(x)
+            x = act(nn.Dense(width, kernel_init=nn.initializers.orthogonal(jnp.sqrt(2.0)))(x))
+        x = nn.Dense(self.action_size, kernel_init=nn.initializers.orthogonal(0.01))(x)
+        return jnp.tanh(x) if self.tanh_output else x
 
 
 @struct.dataclass
