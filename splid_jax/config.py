@@ -4,6 +4,7 @@ command line is generated (each field's ``help`` is its ``--help`` line)."""
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 from typing import Any
 
@@ -23,7 +24,25 @@ class TrainConfig:
     num_envs: int = _f(None, "episodes explored in parallel per iteration")
     sigma: float = _f(1.0, "std of the Gaussian exploration noise added to the policy's action")
     horizon: int = _f(8, "learning horizon H: hindsight goals come from 1..H steps ahead")
+    algo: str = _f(
+        "splid",
+        "learner: splid (Algorithm 2), gcsl (every relabelled pair cloned), pchid (SPLID with the horizon "
+        "grown 1..H, see --pchid-every), her (DDPG + HER), es (OpenAI-ES)",
+    )
     select: bool = _f(True, "SELECT by first hit time; --no-select stores every relabelled pair (ablation)")
+    relabel: str = _f(
+        None,
+        "splid/pchid candidates: paper (Algorithm 2 exactly) or hold (also steps whose goal is already "
+        "achieved and held for H steps, kept when the policy is not at the goal after H steps)",
+    )
+    gcsl_relabel: str = _f(
+        "final", "gcsl: the later goal each step is paired with: final (the episode's last) or future (uniform)"
+    )
+    pchid_every: int = _f(
+        0,
+        "pchid: iterations per horizon step; the horizon is min(H, 1 + iteration // pchid_every), "
+        "0 picks pchid_every so that H is reached half-way through the run",
+    )
     select_lanes: float = _f(
         None, "parallel SELECT replay lanes as a fraction of the T x N explored steps (speed only, never a verdict)"
     )
@@ -53,8 +72,16 @@ class TrainConfig:
             if getattr(self, name) is None:
                 object.__setattr__(self, name, value)
         object.__setattr__(self, "hidden", tuple(int(w) for w in self.hidden))
+        check(0 <= self.seed < 2**32, "seed", self.seed, "an integer in [0, 2**32)")
+        for f in dataclasses.fields(self):  # inf and nan pass every range check, and JSON cannot hold them
+            if f.type == "float":
+                check(math.isfinite(getattr(self, f.name)), f.name, getattr(self, f.name), "a finite number")
         check(self.iterations >= 1, "iterations", self.iterations, "an integer >= 1")
         check(self.num_envs >= 1, "num_envs", self.num_envs, "an integer >= 1")
+        check(self.algo in ALGOS, "algo", self.algo, "one of " + ", ".join(ALGOS))
+        check(self.relabel in RELABELS, "relabel", self.relabel, "one of " + ", ".join(RELABELS))
+        check(self.gcsl_relabel in ("final", "future"), "gcsl_relabel", self.gcsl_relabel, "final or future")
+        check(self.pchid_every >= 0, "pchid_every", self.pchid_every, "an integer >= 0")
         check(self.sigma >= 0, "sigma", self.sigma, ">= 0")
         check(self.horizon >= 1, "horizon", self.horizon, "an integer >= 1 (and < the episode length)")
         check(0 < self.select_lanes <= 1, "select_lanes", self.select_lanes, "in (0, 1]")
@@ -105,7 +132,11 @@ def saved_fields(saved: dict[str, Any]) -> dict[str, Any]:
     return {**_BEFORE_FIELD_EXISTED, **{k: v for k, v in saved.items() if k in names}}
 
 
+ALGOS = ("splid", "gcsl", "pchid", "her", "es")
+RELABELS = ("paper", "hold")
+
 _POINT = dict(
+    relabel="paper",
     iterations=100,
     select_lanes=1.0,
     num_envs=32,
@@ -120,6 +151,7 @@ _POINT = dict(
     eval_episodes=200,
 )
 _FETCH = dict(
+    relabel="paper",
     iterations=200,
     select_lanes=1.0,
     num_envs=256,

@@ -9,7 +9,13 @@ a replay ends as soon as the policy hits g'. So SELECT runs as a work queue: a f
 vmapped replay lanes, each taking the next valid candidate from the queue as soon as its current one
 is decided, in one ``lax.while_loop`` that ends when the queue is empty. Every valid candidate is
 decided, no lane steps past its verdict, and the simulator step appears once in the compiled
-program (MJX compile time)."""
+program (MJX compile time).
+
+``hold=True`` adds the candidates Algorithm 2 leaves out: those whose goal is already achieved at
+s_t and still achieved H steps later (the explored actions kept the object there). Their verdict is
+taken at the final step: the pair is kept only if the policy, restored at s_t, is NOT at g' after H
+steps. Without them the buffer never holds a state whose goal is achieved, so the policy is never
+shown what to do there and pushes through the goal."""
 
 from __future__ import annotations
 
@@ -29,19 +35,24 @@ class Candidates(NamedTuple):
     obs: jax.Array  # [M, O], M = H * T * N, layout [H, T, N]
     goal: jax.Array  # [M, G]
     action: jax.Array  # [M, A]
-    valid: jax.Array  # [M] a real candidate: t + h <= T, the goal moved, no NaN, h <= horizon
+    valid: jax.Array  # [M] a real candidate: t + h <= T, the goal moved (or is held), no NaN, h <= horizon
     accept: jax.Array  # [M] valid and not solved by the current policy within h steps
+    held: jax.Array  # [M] valid candidates whose goal was already achieved at s_t (verdict at the final step)
     replay_steps: jax.Array  # [] int32, simulator control steps the replays took
 
 
-def policy_reaches(env: GoalEnv, policy: Policy, pstate: PolicyState, state: State, goal: jax.Array, h):
-    """Whether the deterministic policy, restored at ``state``, hits ``goal`` within ``h`` steps:
-    the definition the work queue must agree with (tests compare them)."""
+def policy_reaches(
+    env: GoalEnv, policy: Policy, pstate: PolicyState, state: State, goal: jax.Array, h, at_final=False
+):
+    """Whether the deterministic policy, restored at ``state``, hits ``goal`` within ``h`` steps (or,
+    ``at_final``, is at it after exactly ``h`` steps): the definition the work queue must agree with
+    (tests compare them)."""
 
     def one_step(_, carry):
         s, hit = carry
         s = env.step(s, policy.act(pstate, s.obs, s.desired_goal))
-        return s, hit | (s.success & ~s.invalid)
+        now = s.success & ~s.invalid
+        return s, jnp.where(at_final, now, hit | now)
 
     _, hit = jax.lax.fori_loop(0, h, one_step, (env.with_goal(state, goal), jnp.bool_(False)))
     return hit
@@ -76,10 +87,13 @@ def replay_queue(
     horizon_of: jax.Array,
     valid: jax.Array,
     lanes: int,
+    at_final: jax.Array | None = None,
 ) -> tuple[jax.Array, jax.Array]:
     """For every valid candidate c: does the policy, restored at ``starts[start_of[c]]`` pursuing
-    ``goals[c]``, hit it within ``horizon_of[c]`` steps? Returns (reached [M], replay steps [])."""
+    ``goals[c]``, hit it within ``horizon_of[c]`` steps (where ``at_final[c]``: is it at the goal
+    after exactly that many)? Returns (reached [M], replay steps [])."""
     m = valid.shape[0]
+    at_final = jnp.zeros(m, bool) if at_final is None else at_final
     # longest replays first: the lanes that finish last are then the short ones
     order = jnp.argsort(jnp.where(valid, -horizon_of, 1), stable=True).astype(jnp.int32)
     count = jnp.sum(valid, dtype=jnp.int32)
@@ -108,7 +122,7 @@ def replay_queue(
         s = step_batch(env, q.state, policy.act(pstate, q.state.obs, q.state.desired_goal))
         steps = q.steps + 1
         hit = s.success & ~s.invalid
-        done = q.active & (hit | (steps >= horizon_of[q.cand]))
+        done = q.active & ((hit & ~at_final[q.cand]) | (steps >= horizon_of[q.cand]))
         reached = q.reached.at[jnp.where(done, q.cand, m)].set(hit)
         # finished lanes take the next candidates in queue order
         pos = q.next + jnp.cumsum(done, dtype=jnp.int32) - 1
@@ -137,33 +151,42 @@ def select(
     horizon: jax.Array,
     use_select: bool,
     lanes: float = 1.0,
+    hold: bool = False,
 ) -> Candidates:
     """``max_horizon`` fixes the shapes; ``horizon`` (traced, <= max_horizon) masks the candidates
     of larger h, so runs with different H share one compiled program. ``use_select=False`` is the
     ablation: every valid pair is stored, nothing is replayed. ``lanes`` sets the width of the
-    replay batch as a fraction of the T x N explored steps; it changes speed, never a verdict."""
+    replay batch as a fraction of the T x N explored steps; it changes speed, never a verdict.
+    ``hold`` adds the held-goal candidates (module docstring), one per explored step, at h = H."""
     T, H = env.episode_length, max_horizon
     n = traj.actions.shape[1]
     hs = jnp.arange(1, H + 1)
     t = jnp.arange(T)
     later = jnp.minimum(t[None, :] + hs[:, None], T)  # [H, T] index of s_{t+h}, clamped
     goal = traj.achieved[later]  # [H, T, N, G]
-    valid = (
-        (t[None, :] + hs[:, None] <= T)[..., None]
-        & ~env.success(traj.achieved[:T][None], goal)  # nothing achieved between t and t + h
-        & ~traj.invalid[:T][None]
-        & ~traj.invalid[later]
-        & (hs <= horizon)[:, None, None]
-    ).reshape(-1)
+    real = (t[None, :] + hs[:, None] <= T)[..., None] & ~traj.invalid[:T][None] & ~traj.invalid[later]
+    achieved_at_t = env.success(traj.achieved[:T][None], goal)
+    moved = real & ~achieved_at_t & (hs <= horizon)[:, None, None]  # Algorithm 2's candidates
+    held = real & achieved_at_t & (hs == horizon)[:, None, None] & hold
+    valid, held = (moved | held).reshape(-1), held.reshape(-1)
     goal = goal.reshape(H * T * n, -1)
     if use_select:
         starts = jax.tree_util.tree_map(lambda x: x.reshape((T * n,) + x.shape[2:]), traj.states)
         flat = jnp.arange(H * T * n, dtype=jnp.int32)
         reached, steps = replay_queue(
-            env, policy, pstate, starts, goal, flat % (T * n), flat // (T * n) + 1, valid, num_lanes(T, n, lanes)
+            env,
+            policy,
+            pstate,
+            starts,
+            goal,
+            flat % (T * n),
+            flat // (T * n) + 1,
+            valid,
+            num_lanes(T, n, lanes),
+            at_final=held,
         )
         accept = valid & ~reached
     else:
         accept, steps = valid, jnp.int32(0)
     tile = lambda x: jnp.broadcast_to(x[None], (H,) + x.shape).reshape((H * T * n,) + x.shape[2:])  # noqa: E731
-    return Candidates(tile(traj.states.obs), goal, tile(traj.actions), valid, accept, steps)
+    return Candidates(tile(traj.states.obs), goal, tile(traj.actions), valid, accept, held, steps)

@@ -8,14 +8,16 @@ import jax.numpy as jnp
 import optax
 from flax import struct
 
-from envs.base import GoalEnv
-from splid_jax import relabel_buffer
+from envs.base import GoalEnv, check
+from splid_jax import gcsl, relabel_buffer
 from splid_jax.bc import bc_epoch
 from splid_jax.config import TrainConfig
 from splid_jax.evaluate import evaluate
 from splid_jax.explore import explore
 from splid_jax.networks import PolicyState, make_policy
 from splid_jax.select import select
+
+BC_ALGOS = ("splid", "gcsl", "pchid")
 
 
 @struct.dataclass
@@ -37,15 +39,16 @@ class Hyper:
 
 
 class Trainer:
-    """SPLID as an ``algorithm.Algorithm``: holds what is static (task, network, optimiser, shapes);
-    all state flows through arguments."""
+    """The behaviour-cloning learners as ``algorithm.Algorithm``s: SPLID (``cfg.algo`` "splid"), PCHID
+    (SPLID whose horizon grows from 1 to H) and GCSL (every relabelled pair cloned). Holds what is
+    static (task, network, optimiser, shapes); all state flows through arguments."""
 
-    name = "splid"
-
-    def __init__(self, env: GoalEnv, cfg: TrainConfig, max_horizon: int | None = None):
+    def __init__(self, env: GoalEnv, cfg: TrainConfig):
+        check(cfg.algo in BC_ALGOS, "algo", cfg.algo, "one of " + ", ".join(BC_ALGOS) + " for this learner")
         cfg.check_env(env)
-        self.env, self.cfg = env, cfg
-        self.max_horizon = cfg.horizon if max_horizon is None else max_horizon
+        self.env, self.cfg, self.name = env, cfg, cfg.algo
+        self.max_horizon = cfg.horizon  # shapes; a sweep's members mask larger h through Hyper.horizon
+        self.pchid_every = cfg.pchid_every or max(1, cfg.iterations // (2 * cfg.horizon))
         self.policy = make_policy(env.obs_size, env.goal_size, env.action_size, cfg.hidden, cfg.normalise)
         self.optimiser = optax.adam(cfg.learning_rate)
 
@@ -70,9 +73,22 @@ class Trainer:
 
     def iteration(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
         env, cfg, policy = self.env, self.cfg, self.policy
-        key, k_explore, k_bc = jax.random.split(ts.key, 3)
+        key, k_explore, k_bc, k_relabel = jax.random.split(ts.key, 4)
         traj = explore(env, policy, ts.policy, k_explore, cfg.num_envs, hyper.sigma)
-        cands = select(env, policy, ts.policy, traj, self.max_horizon, hyper.horizon, cfg.select, cfg.select_lanes)
+        if cfg.algo == "gcsl":
+            cands = gcsl.relabel(env, traj, cfg.gcsl_relabel, k_relabel)
+        else:
+            cands = select(
+                env,
+                policy,
+                ts.policy,
+                traj,
+                self.max_horizon,
+                self.horizon_at(ts.iteration, hyper),
+                cfg.select,
+                cfg.select_lanes,
+                hold=cfg.relabel == "hold",
+            )
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
         pstate = policy.update_normaliser(ts.policy, traj.states.obs, traj.achieved[:-1], ~traj.invalid[:-1])
         pstate, opt_state, online, loss = bc_epoch(
@@ -89,6 +105,8 @@ class Trainer:
         )
         metrics = {
             "select_pairs": jnp.sum(cands.valid, dtype=jnp.int32),
+            "select_held": jnp.sum(cands.valid & cands.held, dtype=jnp.int32),
+            "select_held_accepted": jnp.sum(cands.accept & cands.held, dtype=jnp.int32),
             "select_accepted": jnp.sum(cands.accept, dtype=jnp.int32),
             "select_steps": cands.replay_steps,
             "bc_loss": loss,
@@ -99,6 +117,12 @@ class Trainer:
         )
         return new, metrics
 
+    def horizon_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
+        """The learning horizon of this iteration: H, or PCHID's curriculum 1, 2, ..., H."""
+        if self.cfg.algo != "pchid":
+            return hyper.horizon
+        return jnp.minimum(hyper.horizon, 1 + iteration // self.pchid_every).astype(jnp.int32)
+
     def chunk(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
         ts, per_iter = jax.lax.scan(lambda s, _: self.iteration(s, hyper), ts, None, length=self.cfg.eval_every)
         key, k_eval = jax.random.split(ts.key)
@@ -106,6 +130,9 @@ class Trainer:
         metrics.update(
             select_pairs=jnp.sum(per_iter["select_pairs"]),
             select_accepted=jnp.sum(per_iter["select_accepted"]),
+            select_held=jnp.sum(per_iter["select_held"]),
+            select_held_accepted=jnp.sum(per_iter["select_held_accepted"]),
+            horizon=self.horizon_at(ts.iteration - 1, hyper),
             select_steps=per_iter["select_steps"],  # [eval_every]: summed on the host, where ints do not overflow
             bc_loss=per_iter["bc_loss"][-1],
             explore_success=jnp.mean(per_iter["explore_success"]),

@@ -131,3 +131,25 @@ def test_no_valid_candidate_means_no_replay(env):
     traj = scripted_trajectory(env, jnp.full((2, 2), -4.8), jnp.zeros((2, 2)))  # nothing moves
     cands = select(env, policy, pstate, traj, H, jnp.int32(H), True)
     assert not np.asarray(cands.valid).any() and int(cands.replay_steps) == 0
+
+
+def test_held_goals_are_kept_where_the_policy_leaves_them_and_judged_at_the_final_step(env):
+    """``hold``: a point that stayed put (explored action 0) holds its goal for H steps; a policy that
+    drifts +x leaves it (keep the pair), one that stays holds it too (reject). Only h = H is a held
+    candidate, and the verdict is the final step's: a policy that passes through g' still fails."""
+    traj = scripted_trajectory(env, jnp.array([[-2.0, -4.8]]), jnp.zeros((1, 2)))
+    hs, ts = np.repeat(np.arange(1, H + 1), T), np.tile(np.arange(T), H)
+    drift, p_drift = constant_policy(env, [1.0, 0.0])
+    stay, p_stay = constant_policy(env, [0.0, 0.0])
+    kept = select(env, drift, p_drift, traj, H, jnp.int32(H), True, hold=True)
+    np.testing.assert_array_equal(kept.held, (hs == H) & (ts + hs <= T))
+    np.testing.assert_array_equal(kept.accept, kept.held)
+    assert int(kept.replay_steps) == H * int(kept.held.sum())  # held replays run their full H
+    assert not np.asarray(select(env, stay, p_stay, traj, H, jnp.int32(H), True, hold=True).accept).any()
+    assert not np.asarray(select(env, drift, p_drift, traj, H, jnp.int32(H), True).valid).any()  # paper: none
+    # a policy that crosses g' and comes back within the success radius only at some middle step
+    goal = traj.achieved[0, 0]
+    there = jax.tree_util.tree_map(lambda x: x[0, 0], traj.states)
+    assert bool(policy_reaches(env, drift, p_drift, there, goal, H)) and not bool(
+        policy_reaches(env, drift, p_drift, there, goal, H, at_final=True)
+    )
