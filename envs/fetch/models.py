@@ -1,88 +1,29 @@
 """MJCF models of the Fetch-style tasks, written for MJX: a gripper, a table and an object.
 
-Everything is a primitive geom with ``contype = conaffinity = 0``; the only collisions are the
-``<contact><pair>`` entries listed below, so MJX evaluates exactly those and nothing else.
+Every geom is a primitive with ``contype = conaffinity = 0``; the only collisions are the
+``<contact><pair>`` entries, so MJX evaluates exactly those.
 
-The gripper is a body on three world-aligned slide joints (x, y, z), each driven by a position
-actuator (kp = m w^2, w = 50 rad/s) with joint damping 2 m w (critical), so it follows its target
-like the reference's mocap weld (solref 0.02 1) follows the mocap body. The joint damping is
-integrated implicitly by the Euler integrator, so the drive stays stable at 10 ms timesteps; the z
-actuator carries a constant bias ``m g`` (gravity compensation, as the reference arm is held by its
-weld). Fingers: for Reach/Push/Slide (gripper blocked) they are one fixed closed block (Slide:
-four round tips at its corners, see below); for PickAndPlace two slide joints with position
-actuators (kp 30000, control 0..0.2, joint range 0..0.05, as the reference) and friction-1, condim-4
-contacts with the object.
+- Gripper: a body on three world-aligned slide joints, each driven by a position actuator
+  (kp = m w^2, w = 50 rad/s) with critical joint damping 2 m w, so it follows its target as the
+  reference's mocap weld (solref 0.02 1, the same time constant) follows its mocap body; the z
+  actuator carries ``m g`` as gravity compensation. Slide joints rather than a welded free body
+  because the weld adds 3 dofs and 6 constraint rows and ran slower in MJX; the damping, integrated
+  implicitly, keeps the drive stable at long timesteps. ``drive="weld"`` pulls the same joints by
+  the reference's weld law instead (a connect constraint to a mocap body).
+- Reach: the reference's gripper hangs on a 7-joint arm, ours on none, so ``within_reach`` keeps the
+  target within the arm's measured reach (task field ``workspace``); only Slide's goals exceed it.
+- Fingers: one fixed closed block for Reach, Push and Slide; for PickAndPlace two slide joints with
+  position actuators (kp 30000, range 0..0.05, as the reference).
+- Table: its top face is a plane at z = 0.4, a cheaper contact than the reference's box
+  (``table="box"`` gives the box). An object pushed past an edge glides on instead of falling; every
+  goal lies on or above the table, so such an episode fails on both.
+- Slide: the reference's cylinder puck (radius 0.025, half-height 0.02, mass 2, friction 0.1 on the
+  table). MJX collides a cylinder with a sphere but not with a box, so the closed fingers strike it
+  with four round corner tips. The gripper weighs 13 kg, the reference arm's effective mass at the
+  grip site; lighter, it launches the puck too slowly.
+- ``finger="capsule"``: Push's finger block as a capsule, a cheaper contact (an option).
 
-Why slide joints, not the reference's mocap weld: measured on this 2-core CPU (shared, so
-figures are rough) on the Push model at 10 x 4 ms, the slide-joint drive ran 7,200 control
-steps/s in MuJoCo C and 1,050 in MJX at batch 64 (compile 24 s), a free-joint gripper welded to a
-mocap body 5,100 and 590 (compile 50 s): the weld adds 3 dofs and 6 constraint rows. Both follow a
-target moved 5 cm ahead at every control step alike: the grip advances 3.0 cm in the first step,
-then 3.4 cm per step (weld: 3.2 cm), and stops within 0.2 mm of the target once it is held, so
-neither reaches the full 5 cm within one step, the reference's weld (same time constant) neither.
-The task field ``drive="weld"`` keeps the slide joints but pulls them with the reference's weld law
-instead (a connect constraint to a mocap body, 3 rows; see ``mjcf``); its cost on the GPU is in
-BENCHMARKS.md section 1.
-
-Reach. The reference's gripper hangs on a 7-joint arm, ours on none: the tasks keep each target
-within the arm's measured reach (``within_reach``, task field ``workspace``). Driven at full action
-toward a far target the reference's gripper slows as the arm straightens and stops on a sphere; ours,
-with the reach, stops on the same sphere, its path there 1.7 cm (RMS) from the reference's
-(experiments/parity/arm_reach.py). Only Slide, whose robot stands further back, meets it in play.
-
-Contact pairs: object-table (plane-box), finger(s)-object (box-box); Slide's are below. The gripper
-has no pair with the table: its z target is clipped so that the fingertips stay at or above the
-table top instead (see ``Layout.workspace``).
-
-Table. Its collision shape is its top face, a plane at z = 0.4, drawn over a non-colliding box
-(``table="box"`` gives the reference's box table and an object-floor pair instead). The plane-box
-contact is the cheaper one: one Push control step at batch 64 on the 2-core CPU took 16.5 ms
-against 22.4 ms with the box table (2026-11-23), and the scripted controllers succeed as often
-(200 episodes each, CPU MJX: Push and PickAndPlace 100 / 100 % with either table). A plane is
-infinite, so an object pushed past a table edge glides on at table height instead of falling;
-every goal lies on or above the table, so such an episode fails either way.
-
-Push finger (option, not the default). ``finger="capsule"`` makes the closed finger block a vertical
-capsule (radius 1.1 cm, the block's height), so the finger-cube contact is capsule-box instead of
-box-box. Measured on the 2-core CPU (2026-11-23, plane table, ``experiments/bench_env.py --batch 64``):
-7,185 control steps/s against 4,999 (1.44x), and the scripted Push succeeded in 200 / 200 episodes
-at any and at the final step (mean |displacement| 0.173 m, final distance 4.4 mm; box finger 0.173 m, 4.1 mm; reference
-0.185 m, 4.7 mm). Its GPU throughput and its effect on learning are not measured yet.
-
-Slide. The puck is the reference's cylinder (radius 0.025, half-height 0.02, mass 2) with the
-reference's low friction (0.1, 0.005, 0.0001) on the puck-table pair. MJX 3.17 collides a cylinder
-with a plane, a sphere, a capsule or a cylinder, not with a box, so:
-
-- the table top is the plane (required: ``table="box"`` is refused for Slide). The puck cannot fall
-  off the table's edges (x 0.695..1.945, y 0.3..1.2) as the reference's does; goals lie at most
-  1.713 + 0.05 in x, so a puck past the edge fails in both.
-- the closed fingers strike it with four round corner tips (spheres of radius 0.004 at the grip
-  site's height, at (+-0.0155, +-0.0155) from it, the corner ``scripted.slide`` aims with); the
-  finger block is drawn only. A round tip pushes along the line from its centre to the puck's axis,
-  as the reference's box-finger corner does; the tip-puck pair has the reference finger-puck pair's
-  friction (1, torsional 0.05, condim 4).
-- the gripper weighs 13 kg (``SLIDE_GRIPPER_MASS``; drive gains scale with it, so its free motion is
-  unchanged): the reference arm's effective mass at the grip site along x and y (13.3 and 12.3 kg,
-  from its mass matrix at the Slide start). With the 4 kg of the other tasks a struck puck left
-  slower and stopped short (MuJoCo C replica, ``experiments/parity/slide_c.py``, 200 episodes:
-  23.5 % of them more than 5 cm short and 76.5 % success, against 2.5 % and 97.5 % at 13 kg).
-
-- the drive stays the PD drive. The reference's weld law (task field ``drive="weld"``; ``mjcf``'s
-  ``drive``) launches the struck puck nearer the reference's speed and spread at our 4 ms (0.980 +-
-  0.028 of the controller's wanted speed, the reference's 0.991 +- 0.021, PD's 0.967 +- 0.015; MuJoCo
-  C replica, 200 episodes, ``experiments/parity/slide_strike.py``), but not at the reference's own
-  2 ms (0.967 +- 0.013), so that agreement is not the reference's mechanism; SPLID learns Slide less
-  under it, and it costs 11 % of Slide's GPU throughput (``experiments/parity/README.md``, "Slide's
-  strike, measured"; BENCHMARKS.md sections 1 and 3).
-
-- what stays different is the arm. The reference's final-step success on Slide moves from 79.5 to
-  90.1 % when its arm's joint damping is scaled by 0 to 2 (1,000 episodes), and a hand on two hinges
-  fitted to the arm's inertia and damping at the grip site passes the puck on like the reference's but
-  launches it slower (``experiments/parity/slide_hand.py``; README there, first finding).
-
-The earlier Slide model (a box puck of the same size on the box table, struck by the box finger
-block) tipped and spun the puck and launched it off the aimed line: 62.5 % any-step success against
-the reference's 96.5 % (see ``experiments/parity/README.md``).
+How these compare with the reference: ``experiments/parity/README.md``.
 """
 
 from __future__ import annotations

@@ -1,49 +1,26 @@
 """Fetch-style tasks (Reach, Push, Slide, PickAndPlace) as pure MJX functions.
 
-Each task follows the reference Gymnasium-Robotics ``Fetch*-v4`` tasks (see ``envs/fetch/models.py``
-for the models): 25-float observation in the reference order (10 for Reach), achieved goal = object
-position (grip position for Reach), sparse reward ``-(d > threshold)``, 50-step episodes, action
-``a`` in [-1, 1]^4 moving the gripper target by ``0.05 * a[:3]`` per 0.04 s control step.
+Each follows Gymnasium-Robotics ``Fetch*-v4`` (models in ``envs/fetch/models.py``): the 25-float
+observation in the reference's order (10 for Reach), achieved goal = object position (grip position
+for Reach), sparse reward ``-(d > threshold)``, 50-step episodes, action ``a`` in [-1, 1]^4 moving
+the gripper target by ``0.05 * a[:3]`` per 0.04 s control step.
 
-Gripper target. As in the reference (mocap body reset onto the gripper, then moved by the delta),
-each control step sets the xyz target to the *current* grip position plus ``0.05 * a[:3]``, clipped
-to a workspace box whose floor keeps the fingertips at or above the table top, then within the
-reference arm's reach (``models.within_reach``: the gripper slows as it nears the arm's reach and
-stops on its sphere, as the reference's does; ``workspace="box"`` drops this). The target is the
-actuator control, which ``Physics`` holds, so nothing else needs saving. With ``drive="weld"`` a
-constraint pulls the gripper to a mocap body that ``simulate`` puts at that target instead.
+Gripper target: as in the reference, the *current* grip position plus ``0.05 * a[:3]``, clipped to
+a workspace box whose floor keeps the fingertips at or above the table, then within the reference
+arm's reach (``models.within_reach``; ``workspace="box"`` drops it). The target is the actuator
+control, which ``Physics`` holds (with ``drive="weld"``, ``simulate`` puts a mocap body there).
 
 ``State.physics`` (a ``Physics``) is the complete simulator state: qpos, qvel, ctrl, time and the
-Newton solver's warm start. ``step`` rebuilds an ``mjx.Data`` from it, so restoring a saved ``State``
-and replaying the same actions reproduces the saved trajectory bit for bit.
+Newton solver's warm start. Restoring a saved ``State`` and replaying the same actions reproduces the
+trajectory bit for bit, which SELECT's restore-and-replay relies on.
 
-Defaults: 10 substeps of 4 ms (the reference takes 20 of 2 ms), Newton with 4 iterations and 4
-line-search iterations (Slide: 10 iterations; with 4 a resting low-friction puck crept up to 10 cm
-in 50 steps in float32 MJX while MuJoCo C held it still; 10 showed no measurable cost at batch 64
-on CPU). Both are task fields (``timestep``, ``substeps``, ``iterations``, ``ls_iterations``).
-MJX's small dense Cholesky solves run unrolled (``envs/small_cholesky.py``; ``cholesky="library"``
-keeps ``jax.scipy.linalg``'s: equal to float rounding, Push 1.65x slower on an H200).
-Measured on CPU on these models, per timing 20 x 2 / 10 x 4 / 4 x 10 ms:
-
-- a crude scripted push, MuJoCo C, 200 episodes: success 0.76-0.83 (10 or 4 iterations) / 0.72 /
-  0.58; a centred push, a = (0.6, 0, 0) for 6 steps, moves the cube 10.0 / 10.4 / 13.0 cm.
-- ``envs.fetch.scripted.push``, 100 episodes, final success: MuJoCo C 1.00 / 0.99 / 0.99, MJX
-  1.00 / 1.00 / 0.97 (median final error 0.36-0.58 cm).
-- ``envs.fetch.scripted.slide`` on the earlier box-puck Slide model, 100 episodes, final success:
-  MuJoCo C 0.28 / 0.37 / 0.56, MJX 0.50 / 0.46 / 0.60 with NaN in some episodes (MuJoCo C warned
-  of instability too). A freely sliding puck travels the same in both (0.5075 / 0.5076 m from
-  1 m/s), so the gap lay in the pusher-puck impacts, whose box-box contacts MuJoCo C and MJX
-  generate differently. The cylinder-puck model (see models.py) reaches 0.965 in MJX at 10 x 4 ms
-  (200 episodes; ``experiments/parity``).
-- ``envs.fetch.scripted.pick_and_place``, 50 episodes, final success: MuJoCo C and MJX both
-  1.00 / 1.00 / 0.00 (median error 0.21 cm): at 10 ms the finger drive (kp 30000) is unstable.
-
-10 x 4 ms keeps the contact behaviour within the spread that solver settings alone cause at 2 ms
-and halves the cost; 4 x 10 ms moves pushed objects further, is unstable on Slide and breaks
-PickAndPlace. On the current models (H100 and CPU MJX, 2026-11-23; ``BENCHMARKS.md`` section 1),
-5 x 8 ms doubles Push's throughput and keeps its scripted success at 100 %, yet SPLID learns less
-per episode there (0.74 against 0.85 eval success after 5,120 episodes, 4 seeds): a scripted
-controller is a weaker test of the dynamics than learning is, so the defaults stay at 10 x 4 ms.
+Defaults: 10 substeps of 4 ms (the reference takes 20 of 2 ms) and Newton with 4 iterations and 4
+line-search iterations (Slide: 10, since with 4 a resting low-friction puck crept in float32 MJX).
+That halves the physics cost and keeps the scripted controllers' success; coarser steps or fewer
+iterations change what SPLID learns (``experiments/NOTES.md``). All are task fields (``timestep``,
+``substeps``, ``iterations``, ``ls_iterations``). MJX's small dense Cholesky solves run unrolled
+(``envs/small_cholesky.py``; ``cholesky="library"`` keeps ``jax.scipy.linalg``'s, equal to float
+rounding and slower on a GPU).
 """
 
 from __future__ import annotations
