@@ -1,0 +1,364 @@
+"""DDPG + HER (Andrychowicz et al. 2017) with the OpenAI Baselines settings, as an
+``algorithm.Algorithm``: one iteration is one Baselines cycle (explore ``num_envs`` episodes in
+parallel, store them whole, ``n_batches`` gradient steps on future-relabelled transitions, one
+Polyak update of the targets), scanned ``eval_every`` times per compiled chunk.
+
+The actor is a ``networks.Policy`` (ReLU, tanh output) whose state also holds the observation and
+goal normaliser, so evaluation, rollouts and checkpoints read it as they read SPLID's policy."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import optax
+from flax import struct
+
+from envs.base import GoalEnv, check, step_batch
+from splid_jax.config import TrainConfig
+from splid_jax.evaluate import evaluate
+from splid_jax.networks import CLIP_NORMALISED, MLP, Policy, PolicyState, running_statistics
+from splid_jax.trainer import params_finite
+
+
+def _f(default, help: str):
+    return dataclasses.field(default=default, metadata={"help": help})
+
+
+@dataclasses.dataclass(frozen=True)
+class HerConfig:
+    """HER's own settings; defaults are OpenAI Baselines' (``baselines/her/experiment/config.py``).
+    Normalised inputs are clipped to +-``networks.CLIP_NORMALISED`` (5, Baselines' norm_clip)."""
+
+    replay_k: int = _f(4, "future strategy: k relabelled goals per original one (relabel probability 1 - 1/(1+k))")
+    gamma: float = _f(0.98, "discount; Baselines uses 1 - 1/T, 0.98 for the 50-step episodes")
+    hidden: tuple[int, ...] = _f((256, 256, 256), "hidden layer widths of the actor and of the critic (ReLU)")
+    actor_lr: float = _f(1e-3, "Adam learning rate of the actor")
+    critic_lr: float = _f(1e-3, "Adam learning rate of the critic")
+    batch_size: int = _f(
+        256, "transitions per gradient step (Baselines: 256 per MPI worker, whose gradients are averaged)"
+    )
+    buffer_transitions: int = _f(1_000_000, "replay capacity in transitions, stored as whole episodes (FIFO)")
+    n_batches: int = _f(40, "gradient steps per iteration (Baselines' n_batches per cycle)")
+    polyak: float = _f(0.95, "target = polyak * target + (1 - polyak) * online, once per iteration")
+    action_l2: float = _f(1.0, "weight of the actor's mean squared action penalty")
+    random_eps: float = _f(0.3, "exploration: probability of a uniformly random action")
+    noise_eps: float = _f(0.2, "exploration: std of the Gaussian noise added to the actor's action")
+    norm_eps: float = _f(0.01, "std floor of the observation and goal normaliser")
+    clip_obs: float = _f(200.0, "observations and goals are clipped to +-clip_obs before normalising")
+
+    def __post_init__(self):
+        object.__setattr__(self, "hidden", tuple(int(w) for w in self.hidden))
+        check(self.replay_k >= 0, "her.replay_k", self.replay_k, "an integer >= 0")
+        check(0 <= self.gamma < 1, "her.gamma", self.gamma, "in [0, 1)")
+        check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "her.hidden", self.hidden, "one or more widths >= 1")
+        check(self.actor_lr > 0, "her.actor_lr", self.actor_lr, "> 0")
+        check(self.critic_lr > 0, "her.critic_lr", self.critic_lr, "> 0")
+        check(self.batch_size >= 1, "her.batch_size", self.batch_size, "an integer >= 1")
+        check(self.buffer_transitions >= 1, "her.buffer_transitions", self.buffer_transitions, "an integer >= 1")
+        check(self.n_batches >= 0, "her.n_batches", self.n_batches, "an integer >= 0")
+        check(0 <= self.polyak <= 1, "her.polyak", self.polyak, "in [0, 1]")
+        check(self.action_l2 >= 0, "her.action_l2", self.action_l2, ">= 0")
+        check(0 <= self.random_eps <= 1, "her.random_eps", self.random_eps, "in [0, 1]")
+        check(self.noise_eps >= 0, "her.noise_eps", self.noise_eps, ">= 0")
+        check(self.norm_eps > 0, "her.norm_eps", self.norm_eps, "> 0")
+        check(self.clip_obs > 0, "her.clip_obs", self.clip_obs, "> 0")
+
+    @property
+    def future_p(self) -> float:
+        return 1.0 - 1.0 / (1.0 + self.replay_k)
+
+
+@struct.dataclass
+class EpisodeBuffer:
+    """Whole episodes in a FIFO ring, so a transition's future achieved goals stay reachable."""
+
+    obs: jax.Array  # [E, T + 1, O]
+    achieved: jax.Array  # [E, T + 1, G]
+    goal: jax.Array  # [E, G]
+    actions: jax.Array  # [E, T, A] executed actions
+    ptr: jax.Array  # [] int32, next episode slot to write
+    size: jax.Array  # [] int32, filled slots
+
+    @property
+    def capacity(self) -> int:
+        return self.obs.shape[0]
+
+
+def buffer_init(episodes: int, T: int, obs_size: int, goal_size: int, action_size: int) -> EpisodeBuffer:
+    return EpisodeBuffer(
+        obs=jnp.zeros((episodes, T + 1, obs_size), jnp.float32),
+        achieved=jnp.zeros((episodes, T + 1, goal_size), jnp.float32),
+        goal=jnp.zeros((episodes, goal_size), jnp.float32),
+        actions=jnp.zeros((episodes, T, action_size), jnp.float32),
+        ptr=jnp.int32(0),
+        size=jnp.int32(0),
+    )
+
+
+def buffer_insert(buf: EpisodeBuffer, new: EpisodeBuffer, mask: jax.Array) -> EpisodeBuffer:
+    """Append the episodes of ``new`` where ``mask`` holds, in order, overwriting the oldest past
+    capacity (of a batch larger than the capacity only the newest ``capacity`` are kept)."""
+    cap = buf.capacity
+    mask = mask.astype(bool)
+    n = jnp.sum(mask, dtype=jnp.int32)
+    rank = jnp.cumsum(mask, dtype=jnp.int32) - 1
+    skip = jnp.maximum(n - cap, 0)
+    slot = jnp.where(mask & (rank >= skip), (buf.ptr + rank - skip) % cap, cap)  # slot == cap is dropped
+
+    def put(old, rows):
+        return old.at[slot].set(rows, mode="drop")
+
+    return buf.replace(
+        obs=put(buf.obs, new.obs),
+        achieved=put(buf.achieved, new.achieved),
+        goal=put(buf.goal, new.goal),
+        actions=put(buf.actions, new.actions),
+        ptr=(buf.ptr + jnp.minimum(n, cap)) % cap,
+        size=jnp.minimum(buf.size + n, cap),
+    )
+
+
+class Transitions(NamedTuple):
+    obs: jax.Array  # [B, O]
+    goal: jax.Array  # [B, G] the original goal, or with probability future_p a later achieved goal
+    action: jax.Array  # [B, A]
+    next_obs: jax.Array  # [B, O]
+    reward: jax.Array  # [B] the task's reward of the next achieved goal for that goal
+    episode: jax.Array  # [B] int32, the slot sampled
+    t: jax.Array  # [B] int32, the step sampled
+    future: jax.Array  # [B] int32 in [t + 1, T], where a relabelled goal was achieved
+    relabelled: jax.Array  # [B] bool
+
+
+def sample_transitions(buf: EpisodeBuffer, key: jax.Array, batch_size: int, future_p: float, reward_of) -> Transitions:
+    """Baselines' future strategy: a uniform episode and step; with probability ``future_p`` the goal
+    becomes the achieved goal of a uniform later step of the same episode; the reward is recomputed.
+    An empty buffer yields slot 0 (callers weight the loss by ``size > 0``)."""
+    T = buf.actions.shape[1]
+    k_ep, k_t, k_future, k_relabel = jax.random.split(key, 4)
+    ep = jax.random.randint(k_ep, (batch_size,), 0, jnp.maximum(buf.size, 1))
+    t = jax.random.randint(k_t, (batch_size,), 0, T)
+    future = jax.random.randint(k_future, (batch_size,), t + 1, T + 1)
+    relabelled = jax.random.uniform(k_relabel, (batch_size,)) < future_p
+    goal = jnp.where(relabelled[:, None], buf.achieved[ep, future], buf.goal[ep])
+    return Transitions(
+        obs=buf.obs[ep, t],
+        goal=goal,
+        action=buf.actions[ep, t],
+        next_obs=buf.obs[ep, t + 1],
+        reward=reward_of(buf.achieved[ep, t + 1], goal),
+        episode=ep,
+        t=t,
+        future=future,
+        relabelled=relabelled,
+    )
+
+
+def td_target(reward: jax.Array, next_q: jax.Array, gamma: float, low: float, high: float) -> jax.Array:
+    """r + gamma Q'(s', pi'(s')), clipped to the returns the sparse reward allows. Time limits are not
+    terminal, so every transition bootstraps (as Baselines)."""
+    return jnp.clip(reward + gamma * next_q, low, high)
+
+
+@struct.dataclass
+class HerState:
+    policy: PolicyState  # the online actor and the shared observation/goal normaliser (acts and evaluates)
+    critic: dict
+    target_actor: dict
+    target_critic: dict
+    actor_opt: optax.OptState
+    critic_opt: optax.OptState
+    buffer: EpisodeBuffer
+    key: jax.Array
+    iteration: jax.Array  # [] int32, completed iterations (cycles)
+
+
+class HER:
+    """DDPG + HER; static parts only, all state flows through arguments."""
+
+    name = "her"
+
+    def __init__(self, env: GoalEnv, cfg: TrainConfig, her: HerConfig | None = None):
+        her = HerConfig() if her is None else her
+        T = env.episode_length
+        check(
+            her.buffer_transitions >= T,
+            "her.buffer_transitions",
+            her.buffer_transitions,
+            f"at least one episode ({T} transitions)",
+        )
+        self.env, self.cfg, self.her = env, cfg, her
+        self.capacity = her.buffer_transitions // T
+        self.policy = Policy(
+            net=MLP(hidden=her.hidden, action_size=env.action_size, activation="relu", tanh_output=True),
+            in_size=env.obs_size + env.goal_size,
+            normalise=True,
+        )
+        self.critic = MLP(hidden=her.hidden, action_size=1, activation="relu")
+        self.actor_opt = optax.adam(her.actor_lr)
+        self.critic_opt = optax.adam(her.critic_lr)
+        # The returns the task's sparse reward allows: Baselines' [-1/(1-gamma), 0] under the Fetch
+        # convention (-1 / 0), [0, 1/(1-gamma)] under the point task's (0 / 1).
+        g = jnp.zeros(env.goal_size)
+        rewards = (float(env.reward_of(g, g)), float(env.reward_of(g, g + 1e3)), 0.0)
+        self.target_range = (min(rewards) / (1 - her.gamma), max(rewards) / (1 - her.gamma))
+
+    def hyper(self) -> dict:
+        return {}
+
+    def init(self, key: jax.Array) -> HerState:
+        env = self.env
+        k_actor, k_critic, k_run = jax.random.split(key, 3)
+        pstate = self.policy.init(k_actor)
+        critic = self.critic.init(k_critic, jnp.zeros((self.policy.in_size + env.action_size,)))
+        return HerState(
+            policy=pstate,
+            critic=critic,
+            target_actor=jax.tree_util.tree_map(jnp.copy, pstate.params),
+            target_critic=jax.tree_util.tree_map(jnp.copy, critic),
+            actor_opt=self.actor_opt.init(pstate.params),
+            critic_opt=self.critic_opt.init(critic),
+            buffer=buffer_init(self.capacity, env.episode_length, env.obs_size, env.goal_size, env.action_size),
+            key=k_run,
+            iteration=jnp.int32(0),
+        )
+
+    def _clip(self, x: jax.Array) -> jax.Array:
+        return jnp.clip(x, -self.her.clip_obs, self.her.clip_obs)
+
+    def _inputs(self, normaliser, obs: jax.Array, goal: jax.Array) -> jax.Array:
+        x = jnp.concatenate([self._clip(obs), self._clip(goal)], axis=-1)
+        return running_statistics.normalize(x, normaliser, max_abs_value=CLIP_NORMALISED)
+
+    def explore(self, pstate: PolicyState, key: jax.Array) -> tuple[EpisodeBuffer, jax.Array, jax.Array]:
+        """``num_envs`` episodes with Baselines' exploration: the actor plus N(0, noise_eps^2), clipped,
+        replaced by a uniform action with probability random_eps. Returns the episodes (batch-major),
+        their validity (no NaN) and whether each succeeded at any step."""
+        env, her, n = self.env, self.her, self.cfg.num_envs
+        k_reset, k_steps = jax.random.split(key)
+        start = jax.vmap(env.reset)(jax.random.split(k_reset, n))
+
+        def one_step(state, k):
+            k_noise, k_coin, k_uniform = jax.random.split(k, 3)
+            mean = self.policy.net.apply(pstate.params, self._inputs(pstate.normaliser, state.obs, state.desired_goal))
+            action = jnp.clip(mean + her.noise_eps * jax.random.normal(k_noise, mean.shape), -1.0, 1.0)
+            uniform = jax.random.uniform(k_uniform, mean.shape, minval=-1.0, maxval=1.0)
+            action = jnp.where(jax.random.bernoulli(k_coin, her.random_eps, (n, 1)), uniform, action)
+            nxt = step_batch(env, state, action)
+            return nxt, (nxt.obs, nxt.achieved_goal, action, nxt.success)
+
+        final, (obs, achieved, actions, success) = jax.lax.scan(
+            one_step, start, jax.random.split(k_steps, env.episode_length)
+        )
+        episodes = EpisodeBuffer(
+            obs=jnp.swapaxes(jnp.concatenate([start.obs[None], obs]), 0, 1),
+            achieved=jnp.swapaxes(jnp.concatenate([start.achieved_goal[None], achieved]), 0, 1),
+            goal=start.desired_goal,
+            actions=jnp.swapaxes(actions, 0, 1),
+            ptr=jnp.int32(0),
+            size=jnp.int32(n),
+        )
+        valid = ~final.invalid  # the flag stays set once a NaN was seen
+        return episodes, valid, jnp.any(success, axis=0) & valid
+
+    def update_normaliser(self, pstate: PolicyState, episodes: EpisodeBuffer, valid: jax.Array, key) -> PolicyState:
+        """As Baselines: statistics of (obs, goal) over num_envs * T relabelled transitions of the new
+        episodes; episodes with a NaN carry no weight."""
+        n = episodes.obs.shape[0] * self.env.episode_length
+        tr = sample_transitions(episodes, key, n, self.her.future_p, self.env.reward_of)
+        x = jnp.concatenate([self._clip(tr.obs), self._clip(tr.goal)], axis=-1)
+        w = valid[tr.episode].astype(jnp.float32)
+        x = jnp.where(w[:, None] > 0, x, 0.0)
+        stats = running_statistics.update(pstate.normaliser, x, weights=w, std_min_value=self.her.norm_eps)
+        return pstate.replace(normaliser=stats)
+
+    def losses(self, actor, critic, pstate: PolicyState, target_actor, target_critic, tr: Transitions):
+        """Critic: squared error to the clipped TD target; actor: -Q(s, pi(s)) + action_l2 * pi^2."""
+        her = self.her
+        x = self._inputs(pstate.normaliser, tr.obs, tr.goal)
+        x_next = self._inputs(pstate.normaliser, tr.next_obs, tr.goal)
+
+        def q(params, x, a):
+            return self.critic.apply(params, jnp.concatenate([x, a], axis=-1))[..., 0]
+
+        next_q = q(target_critic, x_next, self.policy.net.apply(target_actor, x_next))
+        target = jax.lax.stop_gradient(td_target(tr.reward, next_q, her.gamma, *self.target_range))
+
+        def critic_loss(params):
+            q_data = q(params, x, tr.action)
+            return jnp.mean((target - q_data) ** 2), q_data
+
+        def actor_loss(params):
+            pi = self.policy.net.apply(params, x)
+            return -jnp.mean(q(critic, x, pi)) + her.action_l2 * jnp.mean(pi**2)
+
+        (c_loss, q_data), c_grad = jax.value_and_grad(critic_loss, has_aux=True)(critic)
+        a_loss, a_grad = jax.value_and_grad(actor_loss)(actor)
+        return c_loss, a_loss, jnp.mean(q_data), c_grad, a_grad
+
+    def train_step(self, hs: HerState, key: jax.Array) -> tuple[HerState, dict]:
+        """One gradient step of critic and actor, both from the same batch at the same parameters (as
+        Baselines computes them in one pass)."""
+        tr = sample_transitions(hs.buffer, key, self.her.batch_size, self.her.future_p, self.env.reward_of)
+        c_loss, a_loss, q_mean, c_grad, a_grad = self.losses(
+            hs.policy.params, hs.critic, hs.policy, hs.target_actor, hs.target_critic, tr
+        )
+        filled = (hs.buffer.size > 0).astype(jnp.float32)  # no step on an empty buffer
+        c_grad, a_grad = jax.tree_util.tree_map(lambda g: g * filled, (c_grad, a_grad))
+        c_upd, critic_opt = self.critic_opt.update(c_grad, hs.critic_opt, hs.critic)
+        a_upd, actor_opt = self.actor_opt.update(a_grad, hs.actor_opt, hs.policy.params)
+        hs = hs.replace(
+            critic=optax.apply_updates(hs.critic, c_upd),
+            critic_opt=critic_opt,
+            policy=hs.policy.replace(params=optax.apply_updates(hs.policy.params, a_upd)),
+            actor_opt=actor_opt,
+        )
+        return hs, {"critic_loss": c_loss, "actor_loss": a_loss, "q_mean": q_mean}
+
+    def iteration(self, hs: HerState, hyper) -> tuple[HerState, dict]:
+        """One Baselines cycle."""
+        key, k_explore, k_norm, k_train = jax.random.split(hs.key, 4)
+        episodes, valid, success = self.explore(hs.policy, k_explore)
+        hs = hs.replace(
+            buffer=buffer_insert(hs.buffer, episodes, valid),
+            policy=self.update_normaliser(hs.policy, episodes, valid, k_norm),
+        )
+        hs, losses = jax.lax.scan(self.train_step, hs, jax.random.split(k_train, self.her.n_batches))
+        step = 1.0 - self.her.polyak
+        hs = hs.replace(
+            target_actor=optax.incremental_update(hs.policy.params, hs.target_actor, step),
+            target_critic=optax.incremental_update(hs.critic, hs.target_critic, step),
+            key=key,
+            iteration=hs.iteration + 1,
+        )
+        metrics = {k: jnp.mean(v) for k, v in losses.items()}
+        metrics["losses_finite"] = jnp.all(jnp.isfinite(losses["critic_loss"]) & jnp.isfinite(losses["actor_loss"]))
+        metrics["explore_success"] = jnp.mean(success)
+        return hs, metrics
+
+    def chunk(self, hs: HerState, hyper) -> tuple[HerState, dict]:
+        hs, per_iter = jax.lax.scan(lambda s, _: self.iteration(s, hyper), hs, None, length=self.cfg.eval_every)
+        key, k_eval = jax.random.split(hs.key)
+        metrics = evaluate(self.env, self.policy, hs.policy, k_eval, self.cfg.eval_episodes)
+        metrics.update(
+            critic_loss=per_iter["critic_loss"][-1],
+            actor_loss=per_iter["actor_loss"][-1],
+            q_mean=per_iter["q_mean"][-1],
+            explore_success=jnp.mean(per_iter["explore_success"]),
+            buffer_size=hs.buffer.size,
+            finite=params_finite((hs.policy.params, hs.critic)) & jnp.all(per_iter["losses_finite"]),
+        )
+        return hs.replace(key=key), metrics
+
+    def counters(self, iteration: int, select_steps: int) -> dict:
+        """Exploration work after ``iteration`` iterations, as exact Python ints (HER replays nothing)."""
+        episodes = iteration * self.cfg.num_envs
+        return {
+            "iteration": iteration,
+            "episodes": episodes,
+            "env_steps": episodes * self.env.episode_length,
+            "select_steps": select_steps,
+        }
