@@ -1,6 +1,6 @@
-"""``python -m splid_jax.rollout RUN_DIR``: load a run's newest checkpoint, roll its deterministic
-policy out, report success, and draw the episodes (paths on the task's map; rendered frames of the
-MuJoCo tasks where offscreen rendering is available)."""
+"""``python -m splid_jax.rollout RUN_DIR``: roll a run's deterministic policy out, report its success and
+draw the episodes: their paths on the task's map, and for the MuJoCo tasks a video of one episode
+through MuJoCo's offscreen renderer (headless: set MUJOCO_GL=egl, or osmesa without a GPU)."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import argparse
 import json
 import os
 import sys
+import warnings
 
 import jax
 import jax.numpy as jnp
@@ -16,32 +17,48 @@ import numpy as np
 from envs.base import InvalidConfig, step_batch
 from splid_jax import checkpoint
 from splid_jax.cli import add_compile_cache_flag, use_compile_cache
-from splid_jax.config import TrainConfig, saved_fields
+from splid_jax.config import TrainConfig
 from splid_jax.train import env_settings, make_env
 from splid_jax.trainer import Trainer
 
+DESCRIPTION = (
+    "Roll a run's deterministic policy out, report its success and draw the episodes: their paths, "
+    "and for the MuJoCo tasks a video of one episode (headless: set MUJOCO_GL=egl, or osmesa without a GPU)."
+)
+STRIP_FRAMES = 6  # frames of the image strip drawn in place of the video where ffmpeg is absent
 
-def load_policy(run_dir: str):
-    """The task, the trainer and the newest trained state of ``run_dir``."""
+
+class RenderingUnavailable(RuntimeError):
+    """No offscreen OpenGL context can be made in this process."""
+
+
+def load_config(run_dir: str) -> TrainConfig:
     path = os.path.join(run_dir, "config.json")
     if not os.path.isfile(path):
         raise InvalidConfig("run_dir", run_dir, "a run directory holding config.json")
-    with open(path) as fh:
-        cfg = TrainConfig(**{**saved_fields(json.load(fh)), "run_dir": run_dir})
+    try:
+        with open(path) as fh:
+            return TrainConfig(**{**json.load(fh), "run_dir": run_dir})
+    except (json.JSONDecodeError, TypeError):
+        raise InvalidConfig("run_dir", run_dir, "a run directory whose config.json train wrote") from None
+
+
+def load_policy(cfg: TrainConfig, step: int | None = None):
+    """The task, the trainer and the trained state of checkpoint ``step`` (default: the newest)."""
     env = make_env(cfg.env, **cfg.env_overrides())
     trainer = Trainer(env, cfg)
-    step, state, meta = checkpoint.restore(run_dir, trainer.init(jax.random.PRNGKey(0)))
-    saved = meta.get("env")  # absent from checkpoints saved before tasks recorded their options
-    now = env_settings(env)
-    changed = [k for k in now if saved is not None and saved.get(k) != now[k]]
+    like = jax.eval_shape(trainer.init, jax.random.PRNGKey(0))
+    step, state, meta = checkpoint.restore(cfg.run_dir, like, step=step)
+    saved, now = meta["env"], env_settings(env)
+    changed = [k for k in now if saved.get(k) != now[k]]
     if changed:  # the policy is still worth a look under the changed task, so say it rather than stop
         what = ", ".join(f"{k}={saved.get(k)!r} then, {now[k]!r} now" for k in changed)
-        print(f"note: {run_dir} was trained on another version of the task ({what})", file=sys.stderr)
+        print(f"note: {cfg.run_dir} was trained on another version of the task ({what})", file=sys.stderr)
     return env, trainer, state, step
 
 
 def rollout(env, trainer, pstate, key, episodes: int):
-    """Episodes of the deterministic policy: the states [T + 1, E] and per-step success [T, E]."""
+    """Episodes of the deterministic policy: the states [T + 1, E]."""
 
     def one_step(s, _):
         nxt = step_batch(env, s, trainer.policy.act(pstate, s.obs, s.desired_goal))
@@ -49,8 +66,7 @@ def rollout(env, trainer, pstate, key, episodes: int):
 
     start = jax.vmap(env.reset)(jax.random.split(key, episodes))
     _, later = jax.lax.scan(one_step, start, None, length=env.episode_length)
-    states = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), start, later)
-    return states
+    return jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), start, later)
 
 
 def draw_paths(env, states, out: str, title: str) -> None:
@@ -79,48 +95,118 @@ def draw_paths(env, states, out: str, title: str) -> None:
     fig.savefig(out, dpi=110, bbox_inches="tight")
 
 
-def render_frames(env, states, out: str, episode: int = 0, frames: int = 6) -> bool:
-    """An image strip of one episode through MuJoCo's offscreen renderer; False where no GL."""
-    if not hasattr(env, "mj_model"):
-        return False
-    try:
-        import mujoco
+def _camera(mujoco, start: np.ndarray, goal: np.ndarray):
+    """A free camera framing the episode's start and goal."""
+    cam = mujoco.MjvCamera()
+    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+    cam.lookat[:] = (start + goal) / 2
+    cam.distance = 0.6 + 1.5 * float(np.linalg.norm(goal - start))
+    cam.azimuth, cam.elevation = 150.0, -25.0
+    return cam
 
-        model = env.mj_model()
-        data = mujoco.MjData(model)
-        renderer = mujoco.Renderer(model, 240, 320)
-    except Exception:  # no OpenGL context on this machine
-        return False
+
+def render_frames(model, qpos: np.ndarray, start: np.ndarray, goal: np.ndarray, size=(240, 320)) -> np.ndarray:
+    """Frames [T, H, W, 3] of ``model`` posed at each row of ``qpos`` [T, nq], the goal drawn as a
+    green sphere. Raises ``RenderingUnavailable`` where no offscreen OpenGL context can be made."""
+    import mujoco
+
+    gl = os.environ.get("MUJOCO_GL", "")
+    if not hasattr(mujoco, "Renderer"):  # the MUJOCO_GL backend's library failed to load
+        raise RenderingUnavailable(f"MuJoCo has no renderer with MUJOCO_GL={gl!r}")
+    try:
+        with warnings.catch_warnings():  # GLFW warns before failing without a display; one line says it below
+            warnings.simplefilter("ignore")
+            renderer = mujoco.Renderer(model, *size)
+    except (mujoco.FatalError, RuntimeError) as err:  # GLFW without a display, EGL/OSMesa without a device
+        raise RenderingUnavailable(f"no OpenGL context with MUJOCO_GL={gl!r}") from err
+    data = mujoco.MjData(model)
+    cam = _camera(mujoco, np.asarray(start, np.float64), np.asarray(goal, np.float64))
+    green = np.array([0.1, 0.8, 0.1, 0.6], np.float32)
+    frames = []
+    with renderer:
+        for q in qpos:
+            data.qpos[:] = q
+            mujoco.mj_forward(model, data)
+            renderer.update_scene(data, camera=cam)
+            scene = renderer.scene
+            if scene.ngeom < scene.maxgeom:
+                geom = scene.geoms[scene.ngeom]
+                mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_SPHERE, np.array([0.02, 0, 0]), goal, np.eye(3).ravel(),
+                                    green)  # fmt: skip
+                scene.ngeom += 1
+            frames.append(renderer.render())
+    return np.stack(frames)
+
+
+def write_strip(frames: np.ndarray, out: str, title: str) -> None:
     from matplotlib.figure import Figure
 
-    qpos = np.asarray(states.physics.qpos[:, episode])
-    picks = np.linspace(0, qpos.shape[0] - 1, frames).astype(int)
-    fig = Figure(figsize=(3 * frames, 2.6))
+    picks = np.linspace(0, len(frames) - 1, min(STRIP_FRAMES, len(frames))).astype(int)
+    fig = Figure(figsize=(3 * len(picks), 2.9))
     for i, t in enumerate(picks):
-        data.qpos[:] = qpos[t]
-        mujoco.mj_forward(model, data)
-        renderer.update_scene(data)
-        ax = fig.add_subplot(1, frames, i + 1)
-        ax.imshow(renderer.render())
+        ax = fig.add_subplot(1, len(picks), i + 1)
+        ax.imshow(frames[t])
         ax.set_title(f"step {t}")
         ax.axis("off")
+    fig.suptitle(title)
     fig.savefig(out, dpi=100, bbox_inches="tight")
-    return True
+
+
+def _outputs(out: str, video: bool) -> tuple[str, str]:
+    """The paths figure and the episode's video (or, without ffmpeg, its image strip)."""
+    stem = os.path.splitext(out)[0]
+    return out, stem + (".mp4" if video else "-frames.png")
+
+
+def _check_out(out: str) -> None:
+    """Before any work: the figure's directory exists and is writable, and matplotlib knows its format."""
+    from matplotlib.figure import Figure
+
+    formats = Figure().canvas.get_supported_filetypes()
+    ext = os.path.splitext(out)[1].lstrip(".").lower()
+    if ext not in formats:
+        raise InvalidConfig("out", out, "an image file name ending in ." + ", .".join(sorted(formats)))
+    folder = os.path.dirname(out) or "."
+    if not os.path.isdir(folder) or not os.access(folder, os.W_OK | os.X_OK):
+        raise InvalidConfig("out", out, "a file in an existing, writable directory")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m splid_jax.rollout", description=DESCRIPTION, allow_abbrev=False)
+    p.add_argument("run_dir", metavar="RUN_DIR")
+    p.add_argument("--step", type=int, default=None, help="checkpoint (iteration) to load (default: the newest)")
+    p.add_argument("--episodes", type=int, default=16, help="episodes to roll out (default: 16)")
+    p.add_argument("--seed", type=int, default=123, help="seed of the episodes' starts and goals")
+    p.add_argument(
+        "--out",
+        default=None,
+        metavar="FILE.png",
+        help="figure of the paths; the video goes beside it as FILE.mp4 (default: RUN_DIR/rollout-STEP.png)",
+    )
+    p.add_argument("--overwrite", action="store_true", help="replace output files that already exist")
+    add_compile_cache_flag(p)
+    return p
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m splid_jax.rollout", description=__doc__.split("\n\n")[0])
-    p.add_argument("run_dir")
-    p.add_argument("--episodes", type=int, default=16, help="episodes to roll out (default: 16)")
-    p.add_argument("--seed", type=int, default=123, help="seed of the episodes' starts and goals")
-    p.add_argument("--out", default=None, help="figure of the paths (default: RUN_DIR/rollout.png)")
-    add_compile_cache_flag(p)
+    import mediapy
+
+    p = build_parser()
     a = p.parse_args(argv)
     use_compile_cache(a.compile_cache)
+    video = mediapy.video_is_available()  # ffmpeg on the PATH
     try:
         if a.episodes < 1:
             raise InvalidConfig("episodes", a.episodes, "an integer >= 1")
-        env, trainer, state, step = load_policy(a.run_dir)
+        if a.out is not None:
+            _check_out(a.out)
+        cfg = load_config(a.run_dir)
+        env, trainer, state, step = load_policy(cfg, a.step)
+        figure, frames_out = _outputs(a.out or os.path.join(a.run_dir, f"rollout-{step}.png"), video)
+        mujoco_task = hasattr(env, "mj_model")
+        for path in (figure, frames_out) if mujoco_task else (figure,):
+            if os.path.exists(path) and not a.overwrite:
+                raise InvalidConfig("out", path, "a file that does not exist yet (or pass --overwrite)")
     except (InvalidConfig, checkpoint.CheckpointError) as err:
         print(f"{p.prog}: error: {err}", file=sys.stderr)
         return 2
@@ -130,14 +216,27 @@ def main(argv: list[str] | None = None) -> int:
         f"{a.run_dir} (iteration {step}): success {succ.any(axis=0).mean():.3f} at any step, "
         f"{succ[-1].mean():.3f} at the final step, over {a.episodes} episodes"
     )
-    out = a.out or os.path.join(a.run_dir, "rollout.png")
-    draw_paths(env, states, out, f"{trainer.cfg.env}: iteration {step}")
-    print(f"paths: {out}")
-    strip = os.path.splitext(out)[0] + "-frames.png"
-    if render_frames(env, states, strip):
-        print(f"frames: {strip}")
-    elif hasattr(env, "mj_model"):
-        print("frames: offscreen rendering is not available here (set MUJOCO_GL=egl on a GPU machine)")
+    title = f"{cfg.env}: iteration {step}"
+    draw_paths(env, states, figure, title)
+    print(f"paths: {figure}")
+    if not mujoco_task:
+        return 0
+    try:
+        frames = render_frames(
+            env.mj_model,
+            np.asarray(states.physics.qpos[:, 0]),
+            np.asarray(states.achieved_goal[0, 0]),
+            np.asarray(states.desired_goal[0, 0]),
+        )
+    except RenderingUnavailable as err:
+        print(f"frames: not drawn, offscreen rendering is unavailable here ({err}); try MUJOCO_GL=egl or osmesa")
+        return 0
+    if video:
+        mediapy.write_video(frames_out, frames, fps=round(1 / env.dt))
+        print(f"video of episode 0: {frames_out}")
+    else:
+        write_strip(frames, frames_out, f"{title}, episode 0")
+        print(f"frames of episode 0: {frames_out} (an image strip: no ffmpeg on the PATH for a video)")
     return 0
 
 
