@@ -230,6 +230,9 @@ class HER:
         return jnp.clip(x, -self.her.clip_obs, self.her.clip_obs)
 
     def _inputs(self, normaliser, obs: jax.Array, goal: jax.Array) -> jax.Array:
+        """Baselines' preprocessing. ``evaluate`` goes through ``Policy.mean``, which skips the clip at
+        clip_obs; that changes nothing while mean + 5 std < clip_obs, since the normalised input is
+        clipped at 5 either way."""
         x = jnp.concatenate([self._clip(obs), self._clip(goal)], axis=-1)
         return running_statistics.normalize(x, normaliser, max_abs_value=CLIP_NORMALISED)
 

@@ -147,8 +147,10 @@ def test_her_learns_well_above_a_random_policy(her, learned):
     _, metrics = learned
     baseline = random_policy_success(her.env)
     last = metrics[-1]
-    assert last["eval_success"] > baseline + 0.2, (last, baseline)
-    assert last["eval_success_final"] > baseline + 0.2, (last, baseline)
+    # Seeds 0-3 reach 0.55-0.60 (either measure) against a random policy's 0.21.
+    assert last["eval_success"] > baseline + 0.25, (last, baseline)
+    assert last["eval_success_final"] > baseline + 0.25, (last, baseline)
+    assert last["eval_success"] > metrics[0]["eval_success"] + 0.2
     assert last["finite"] == 1.0 and last["buffer_size"] == min(CHUNKS * 25 * 16, her.capacity)
     assert "select_steps" not in last
     assert her.counters(150, 0) == {"iteration": 150, "episodes": 2400, "env_steps": 120_000, "select_steps": 0}
