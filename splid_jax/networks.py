@@ -15,6 +15,9 @@ with contextlib.redirect_stdout(io.StringIO()):  # brax imports MJX, which print
     from brax.training.acme import running_statistics
 
 CLIP_NORMALISED = 5.0  # normalised inputs are clipped here, as HER does, so outliers cannot dominate
+# Floor of the normaliser's std (HER's eps): an input that never varied in training (Reach's locked
+# fingers) would otherwise have a std near 0, and a deployment offset of 1e-3 would reach the clip.
+STD_MIN = 0.01
 
 
 class MLP(nn.Module):
@@ -79,7 +82,8 @@ class Policy:
         x = jnp.concatenate([obs, goal], axis=-1).reshape(-1, self.in_size)
         w = jnp.ones(x.shape[0], jnp.float32) if valid is None else valid.reshape(-1).astype(jnp.float32)
         x = jnp.where(w[:, None] > 0, x, 0.0)
-        return pstate.replace(normaliser=running_statistics.update(pstate.normaliser, x, weights=w))
+        stats = running_statistics.update(pstate.normaliser, x, weights=w, std_min_value=STD_MIN)
+        return pstate.replace(normaliser=stats)
 
 
 def make_policy(obs_size: int, goal_size: int, action_size: int, hidden: Sequence[int], normalise: bool) -> Policy:
