@@ -17,8 +17,13 @@ from collections.abc import Sequence
 import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg
 
+DESCRIPTION = (
+    "Learning curves of one or more runs: evaluation success (solid: at any step, dashed: at the final step) "
+    "and return, against episodes, env steps and wall-clock seconds."
+)
 REQUIRED = (
     "iteration",
     "episodes",
@@ -185,20 +190,34 @@ def _curves(runs: Sequence[Run], k: int, group: bool) -> list[Curve]:
     return curves
 
 
+def _title(runs: Sequence[Run], curves: Sequence[Curve], k: int, group: bool) -> str:
+    tasks = sorted({str(r.config["env"]) for r in runs if "env" in r.config})
+    title = f"{', '.join(tasks) or _dir_name(runs[0])}: evaluation of {len(runs)} run{'s' * (len(runs) > 1)}"
+    if group:
+        title += f" in {len(curves)} group{'s' * (len(curves) > 1)}, min-max band over seeds"
+    if k > 1:
+        title += f", trailing mean over {k} evaluations"
+    return title
+
+
 def figure(runs: Sequence[Run], k: int = 1, group: bool = False, steps: str = "env") -> Figure:
     curves = _curves(runs, k, group)
     fig = Figure(figsize=(15, 8), layout="constrained")
     axes = fig.subplots(2, 3, sharey="row")
     cmap = matplotlib.colormaps["tab10" if len(curves) <= 10 else "tab20"]
+    # A single evaluation is a point: a line through it alone would draw nothing, so it gets markers.
+    single = [len(c.columns["iteration"]) == 1 for c in curves]
+    markers = ("o", "v") if any(single) else (None, None)  # any step, final step
     for i, curve in enumerate(curves):
         color = cmap(i % cmap.N)
         for col, (x_key, _) in enumerate(_x_axes(steps)):
             x = curve.columns[x_key]
             for row, metrics in enumerate((("eval_success", "eval_success_final"), ("eval_return",))):
                 ax = axes[row, col]
-                for metric, style in zip(metrics, ("-", "--"), strict=False):
+                for metric, style, marker in zip(metrics, ("-", "--"), markers, strict=False):
                     label = curve.label if (row, col, style) == (0, 0, "-") else None
-                    ax.plot(x, curve.columns[metric], style, color=color, label=label, lw=1.5)
+                    marker = marker if single[i] else None
+                    ax.plot(x, curve.columns[metric], style, color=color, label=label, lw=1.5, marker=marker)
                 if curve.low is not None:
                     m = metrics[0]
                     ax.fill_between(x, curve.low[m], curve.high[m], color=color, alpha=0.2, lw=0)
@@ -212,15 +231,12 @@ def figure(runs: Sequence[Run], k: int = 1, group: bool = False, steps: str = "e
     axes[1, 0].set_ylabel("eval return")
     axes[0, 0].set_ylim(-0.02, 1.02)
     handles, names = axes[0, 0].get_legend_handles_labels()
-    if handles:  # below the panels: long sweep labels would cover the curves inside an axis
-        ncols = max(1, min(len(names), 150 // max(len(n) for n in names)))
-        fig.legend(handles, names, loc="outside lower center", ncols=ncols, fontsize="small")
-    title = "min-max band over seeds" if group else ""
-    if k > 1:
-        title = f"{title}, " if title else ""
-        title += f"trailing mean over {k} evaluations"
-    if title:
-        fig.suptitle(title)
+    handles += [Line2D([], [], color="k", ls=style, marker=m) for style, m in zip(("-", "--"), markers, strict=True)]
+    names += ["success at any step", "success at the final step"]
+    # below the panels: long sweep labels would cover the curves inside an axis
+    ncols = max(1, min(len(names), 150 // max(len(n) for n in names)))
+    fig.legend(handles, names, loc="outside lower center", ncols=ncols, fontsize="small")
+    fig.suptitle(_title(runs, curves, k, group))
     return fig
 
 
@@ -232,7 +248,7 @@ def _positive_int(text: str) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m splid_jax.plot", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m splid_jax.plot", description=DESCRIPTION, allow_abbrev=False)
     parser.add_argument("run_dirs", nargs="+", metavar="RUN_DIR", help="run directory with metrics.jsonl")
     parser.add_argument("--out", metavar="FILE.png", help="output image (default: RUN_DIR/curves.png of the first)")
     parser.add_argument("--smooth", type=_positive_int, default=1, metavar="K", help="trailing mean over K evals")
@@ -254,6 +270,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"plot: {e}", file=sys.stderr)
         return 2
     out = ns.out or os.path.join(ns.run_dirs[0], "curves.png")
+    formats = Figure().canvas.get_supported_filetypes()
+    if os.path.splitext(out)[1].lstrip(".").lower() not in formats:
+        print(f"plot: --out {out}: not an image file name (end it in .png, .pdf or .svg)", file=sys.stderr)
+        return 2
     try:
         if os.path.dirname(out):
             os.makedirs(os.path.dirname(out), exist_ok=True)

@@ -69,20 +69,29 @@ def rollout(env, trainer, pstate, key, episodes: int):
     return jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), start, later)
 
 
-def draw_paths(env, states, out: str, title: str) -> None:
+def paths_figure(env, states, title: str):
+    """The episodes' achieved-goal paths in x-y, green where the goal was reached, red where not."""
     from matplotlib.figure import Figure
-    from matplotlib.patches import Rectangle
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch, Rectangle
 
     ag = np.asarray(states.achieved_goal)  # [T + 1, E, G]
     goal = np.asarray(states.desired_goal[0])
     succ = np.asarray(states.success[1:]).any(axis=0)
-    fig = Figure(figsize=(6, 6))
+    fig = Figure(figsize=(6, 6.6))
     ax = fig.add_subplot()
+    legend = [
+        Line2D([], [], color="tab:green", lw=1.2, label="reached its goal"),
+        Line2D([], [], color="tab:red", lw=1.2, label="did not"),
+        Line2D([], [], ls="", marker="o", color="0.3", ms=4, label="start"),
+        Line2D([], [], ls="", marker="*", color="k", ms=9, label="goal"),
+    ]
     if hasattr(env, "boxes"):  # the point task: draw its walls
         for x0, x1, y0, y1 in np.asarray(env.boxes):
             ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, color="0.5"))
         ax.set_xlim(-5, 5)
         ax.set_ylim(-5, 5)
+        legend.append(Patch(color="0.5", label="wall"))
     for e in range(ag.shape[1]):
         colour = "tab:green" if succ[e] else "tab:red"
         ax.plot(ag[:, e, 0], ag[:, e, 1], "-", color=colour, lw=1.2)
@@ -92,7 +101,9 @@ def draw_paths(env, states, out: str, title: str) -> None:
     ax.set_title(title)
     ax.set_xlabel("x of the achieved goal")
     ax.set_ylabel("y")
-    fig.savefig(out, dpi=110, bbox_inches="tight")
+    fig.legend(handles=legend, loc="lower center", ncols=len(legend), fontsize="small", frameon=False)
+    fig.subplots_adjust(bottom=0.14)
+    return fig
 
 
 def _camera(mujoco, start: np.ndarray, goal: np.ndarray):
@@ -217,7 +228,8 @@ def main(argv: list[str] | None = None) -> int:
         f"{succ[-1].mean():.3f} at the final step, over {a.episodes} episodes"
     )
     title = f"{cfg.env}: iteration {step}"
-    draw_paths(env, states, figure, title)
+    paths = f"{title}, {a.episodes} episodes, success {succ.any(axis=0).mean():.2f} at any step"
+    paths_figure(env, states, paths).savefig(figure, dpi=110, bbox_inches="tight")
     print(f"paths: {figure}")
     if not mujoco_task:
         return 0

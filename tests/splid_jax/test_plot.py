@@ -121,3 +121,48 @@ def _with_metrics(root: Path, text: str) -> Path:
 def test_bad_arguments_exit_2(tmp_path):
     assert plot.main([str(make_run(tmp_path, "r", 0)), "--smooth", "0"]) == 2
     assert plot.main([]) == 2
+
+
+def _drawn_pixels(fig, rgb) -> list[int]:
+    """Per panel, the pixels drawn within 10 levels of colour ``rgb``."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    image = np.asarray(canvas.buffer_rgba())[::-1, :, :3].astype(int)  # row 0 at the bottom, as bboxes count
+    near = (np.abs(image - np.asarray(rgb)) <= 10).all(axis=-1)
+    counts = []
+    for ax in fig.axes:
+        b = ax.get_window_extent()
+        counts.append(int(near[int(b.y0) : int(b.y1), int(b.x0) : int(b.x1)].sum()))
+    return counts
+
+
+def test_a_run_with_one_evaluation_draws_a_point_in_every_panel(tmp_path):
+    run = plot.load_run(make_run(tmp_path, "r", 0, n=1))
+    tab_blue = (31, 119, 180)
+    assert min(_drawn_pixels(plot.figure([run]), tab_blue)) > 20
+
+
+def test_figure_has_a_title_and_a_legend_of_both_success_measures(tmp_path):
+    runs = [plot.load_run(make_run(tmp_path, f"s{s}", s)) for s in range(2)]
+    fig = plot.figure(runs, k=3, group=True)
+    title = fig.get_suptitle()
+    assert title.startswith("point: evaluation of 2 runs") and "min-max band" in title and "over 3" in title
+    (legend,) = fig.legends
+    names = [t.get_text() for t in legend.get_texts()]
+    assert names[-2:] == ["success at any step", "success at the final step"]
+    assert plot.figure(runs[:1]).get_suptitle() == "point: evaluation of 1 run"
+
+
+def test_help_is_plain_text_and_abbreviations_are_refused(tmp_path, capsys):
+    assert "``" not in plot.build_parser().format_help()
+    assert plot.main([str(make_run(tmp_path, "r", 0)), "--smoo", "3"]) == 2
+    assert "unrecognized arguments: --smoo" in capsys.readouterr().err
+
+
+def test_out_that_is_not_an_image_is_refused(tmp_path, capsys):
+    run = make_run(tmp_path, "r", 0)
+    assert plot.main([str(run), "--out", str(run / "metrics.jsonl")]) == 2
+    assert capsys.readouterr().err.count("\n") == 1
+    assert (run / "metrics.jsonl").read_text().count("\n") == 12

@@ -43,6 +43,7 @@ def test_rollout_loads_the_newest_checkpoint_and_draws(point_run, capsys):
     assert rollout.main([str(point_run), "--episodes", "4"]) == 0
     out, err = capsys.readouterr()
     assert "iteration 4" in out and "success" in out
+    assert "``" not in rollout.build_parser().format_help()
     assert "another version of the task" not in err
     png = (point_run / "rollout-4.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
@@ -185,3 +186,14 @@ def test_render_frames_draws_the_gripper_moving():
     assert frames[0].std() > 5  # a scene, not a blank image
     np.testing.assert_array_equal(frames[0], frames[1])
     assert (frames[2] != frames[0]).any(axis=-1).mean() > 0.01  # the gripper moved: over 1 % of the pixels
+
+
+def test_paths_figure_has_a_title_and_a_legend():
+    from types import SimpleNamespace
+
+    ag = np.zeros((3, 2, 2))  # [T + 1, E, G]: two episodes of two steps
+    states = SimpleNamespace(achieved_goal=ag, desired_goal=ag + 1, success=np.array([[0, 0], [0, 1], [0, 1]], bool))
+    fig = rollout.paths_figure(make_env("point"), states, "point: iteration 4")
+    assert fig.axes[0].get_title() == "point: iteration 4"
+    (legend,) = fig.legends
+    assert [t.get_text() for t in legend.get_texts()] == ["reached its goal", "did not", "start", "goal", "wall"]
