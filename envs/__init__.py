@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import math
 
 from envs.base import GoalEnv, InvalidConfig, State
 
@@ -39,17 +40,42 @@ def names() -> list[str]:
     return list(_REGISTRY)
 
 
-def make(name: str, **overrides) -> GoalEnv:
-    """Build task ``name`` with field ``overrides``; unknown names or fields fail naming them."""
+def task_class(name: str) -> type[GoalEnv]:
+    """The dataclass of task ``name`` (importing its module); an unknown name fails naming it."""
     if name not in _REGISTRY:
         raise InvalidConfig("env", name, "one of " + ", ".join(_REGISTRY))
     module, cls_name = _REGISTRY[name].split(":")
-    cls = getattr(importlib.import_module(module), cls_name)
-    fields = {f.name for f in dataclasses.fields(cls)}
-    for key in overrides:
+    return getattr(importlib.import_module(module), cls_name)
+
+
+def _as_field_type(where: str, kind: str, value):
+    """An override converted to its field's declared type, or an error naming the field: ``20.5`` is no
+    integer, ``big`` no number."""
+    if kind == "int":
+        if isinstance(value, int):
+            return value
+        raise InvalidConfig(where, value, "an integer")
+    if kind == "float":
+        if isinstance(value, int | float) and math.isfinite(value):
+            return float(value)
+        raise InvalidConfig(where, value, "a finite number")
+    if kind == "str":
+        return str(value)
+    return value
+
+
+def make(name: str, **overrides) -> GoalEnv:
+    """Build task ``name`` with field ``overrides``; unknown names or fields, and values not of the
+    field's type, fail naming them."""
+    cls = task_class(name)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    typed = {}
+    for key, value in overrides.items():
         if key not in fields:
-            raise InvalidConfig(f"{name}.{key}", overrides[key], "one of the fields " + ", ".join(sorted(fields)))
-    return cls(**overrides)
+            raise InvalidConfig(f"{name}.{key}", value, "one of the fields " + ", ".join(sorted(fields)))
+        kind = fields[key].type if isinstance(fields[key].type, str) else fields[key].type.__name__
+        typed[key] = _as_field_type(f"{name}.{key}", kind, value)
+    return cls(**typed)
 
 
-__all__ = ["GoalEnv", "InvalidConfig", "State", "make", "names", "parse_overrides"]
+__all__ = ["GoalEnv", "InvalidConfig", "State", "make", "names", "parse_overrides", "task_class"]

@@ -76,6 +76,10 @@ class TrainConfig:
         for f in dataclasses.fields(self):  # inf and nan pass every range check, and JSON cannot hold them
             if f.type == "float":
                 check(math.isfinite(getattr(self, f.name)), f.name, getattr(self, f.name), "a finite number")
+        check(0 <= self.seed < 2**32, "seed", self.seed, "an integer in [0, 2**32)")
+        for f in dataclasses.fields(self):  # inf and nan pass every range check, and JSON cannot hold them
+            if f.type == "float":
+                check(math.isfinite(getattr(self, f.name)), f.name, getattr(self, f.name), "a finite number")
         check(self.iterations >= 1, "iterations", self.iterations, "an integer >= 1")
         check(self.num_envs >= 1, "num_envs", self.num_envs, "an integer >= 1")
         check(self.algo in ALGOS, "algo", self.algo, "one of " + ", ".join(ALGOS))
