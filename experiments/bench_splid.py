@@ -27,8 +27,8 @@ import jax.numpy as jnp
 
 from splid_jax.config import TrainConfig
 from splid_jax.explore import explore
+from splid_jax.loop import make_algorithm, make_env
 from splid_jax.select import num_lanes, select
-from splid_jax.train import make_env
 from splid_jax.trainer import Trainer
 
 
@@ -102,12 +102,12 @@ def bench_select(env, cfg: TrainConfig, device, repeats: int, pstate=None) -> di
 
 def bench_chunk(env, cfg: TrainConfig, seeds: int, repeats: int) -> dict:
     """Time whole compiled chunks (explore, SELECT, insert, BC, eval) for 1 seed and ``seeds`` seeds."""
-    trainer = Trainer(env, cfg)
-    one, _ = timed(trainer.chunk, trainer.init(jax.random.PRNGKey(0)), trainer.hyper(), repeats=repeats)
+    algo = make_algorithm(cfg, env)
+    one, _ = timed(jax.jit(algo.chunk), algo.init(jax.random.PRNGKey(0)), algo.hyper(), repeats=repeats)
     keys = jnp.stack([jax.random.PRNGKey(s) for s in range(seeds)])
-    states = jax.vmap(trainer.init)(keys)
-    hyper = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (seeds,)), trainer.hyper())
-    many, _ = timed(jax.jit(jax.vmap(trainer.chunk)), states, hyper, repeats=repeats)
+    states = jax.jit(jax.vmap(algo.init))(keys)
+    hyper = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (seeds,)), algo.hyper())
+    many, _ = timed(jax.jit(jax.vmap(algo.chunk)), states, hyper, repeats=repeats)
     return {
         "num_envs": cfg.num_envs,
         "iterations_per_chunk": cfg.eval_every,

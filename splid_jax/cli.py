@@ -1,12 +1,63 @@
-"""Command lines generated from frozen config dataclasses, so ``--help`` documents every field."""
+"""Command lines generated from frozen config dataclasses, so ``--help`` documents every field.
+
+Light on purpose (JAX is imported only where used): the commands import it first, so that a
+signal while JAX loads can already be handled."""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
+import io
 import os
+import signal
 
-import jax
+
+def quiet_interrupts() -> None:
+    """Until a run installs its own handlers, SIGINT and SIGTERM end the process at once with one
+    line and no traceback (exit 130 / 143): nothing has been written yet that a stop could tear."""
+
+    def stop(signum, frame):
+        os.write(2, f"interrupted ({signal.Signals(signum).name}) before the run started\n".encode())
+        os._exit(128 + signum)
+
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, stop)
+
+
+class Parser(argparse.ArgumentParser):
+    """No abbreviated flags (``--learning-rat`` is an error, not ``--learning-rate``), and an
+    ``--env-options`` help that lists every task's fields, importing the tasks only when shown."""
+
+    def __init__(self, **kw):
+        super().__init__(allow_abbrev=False, **kw)
+
+    def format_help(self) -> str:
+        for action in self._actions:
+            if action.dest == "env_options" and not getattr(action, "fields_listed", False):
+                action.help = f"{action.help}. Fields and defaults: {task_fields()}".replace("%", "%%")
+                action.fields_listed = True
+        return super().format_help()
+
+
+def task_fields() -> str:
+    """``task: field=default, ...`` for each task; a task with the previous one's fields names only
+    the defaults that differ."""
+    import envs
+
+    parts, previous = [], None
+    for name in envs.names():
+        with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
+            cls = envs.task_class(name)
+        defaults = {f.name: f.default for f in dataclasses.fields(cls)}
+        if previous is not None and previous[1].keys() == defaults.keys():
+            diff = {k: v for k, v in defaults.items() if v != previous[1][k]}
+            shown = ", ".join(f"{k}={v}" for k, v in diff.items())
+            parts.append(f"{name}: as {previous[0]}" + (f" but {shown}" if shown else ""))
+        else:
+            parts.append(f"{name}: " + ", ".join(f"{k}={v}" for k, v in defaults.items()))
+            previous = (name, defaults)
+    return "; ".join(parts)
 
 
 def _int_tuple(text: str) -> tuple[int, ...]:
@@ -66,5 +117,7 @@ def add_compile_cache_flag(parser: argparse.ArgumentParser) -> None:
 def use_compile_cache(path: str) -> None:
     """JAX's persistent compilation cache: MJX programs take tens of seconds to compile and are
     the same from one run of a setting to the next."""
+    import jax
+
     if path:  # programs that compile in under a second are not kept (JAX's default threshold)
         jax.config.update("jax_compilation_cache_dir", path)

@@ -1,4 +1,4 @@
-"""One terminal line per chunk, and the metrics.jsonl record behind it."""
+"""One terminal line per chunk (per sweep chunk: one summary line), from the metrics.jsonl record."""
 
 from __future__ import annotations
 
@@ -12,19 +12,44 @@ def _si(x: float) -> str:
     return f"{x:.0f}"
 
 
-HEADER = (
-    f"{'iter':>9} {'episodes':>9} {'env st':>7} {'select st':>9} {'steps/s':>8} {'success':>7} {'final':>6} "
-    f"{'return':>7} {'buffer':>6} {'accept':>6} {'bc loss':>8} {'wall s':>7}"
-)
+def _extra(rec: dict) -> list[tuple[str, str]]:
+    """(title, text) of the columns an algorithm's own keys give: its buffer, SELECT's acceptance, losses."""
+    cols = []
+    if "buffer_size" in rec:
+        cols.append(("buffer", _si(rec["buffer_size"])))
+    if "select_pairs" in rec and "select_accepted" in rec:
+        cols.append(("accept", f"{rec['select_accepted'] / max(rec['select_pairs'], 1):.1%}"))
+    for k in rec:
+        if k.endswith("_loss"):
+            cols.append((k.replace("_", " "), f"{rec[k]:.4f}"))
+    return cols
+
+
+def header(rec: dict) -> str:
+    extra = "".join(f" {title:>9}" for title, _ in _extra(rec))
+    return (
+        f"{'iter':>9} {'episodes':>9} {'env st':>7} {'select st':>9} {'steps/s':>8} {'success':>7} {'final':>6} "
+        f"{'return':>7}{extra} {'wall s':>7}"
+    )
 
 
 def line(rec: dict, total_iterations: int) -> str:
-    pairs = max(rec["select_pairs"], 1)
+    extra = "".join(f" {text:>9}" for _, text in _extra(rec))
     return (
         f"{rec['iteration']:>4}/{total_iterations:<4} {rec['episodes']:>9,} {_si(rec['env_steps']):>7} "
         f"{_si(rec['select_steps']):>9} {_si(rec['steps_per_s']):>8} {rec['eval_success']:>7.3f} "
-        f"{rec['eval_success_final']:>6.3f} {rec['eval_return']:>7.2f} {rec['buffer_fill']:>6.1%} "
-        f"{rec['select_accepted'] / pairs:>6.1%} {rec['bc_loss']:>8.4f} {rec['wall_s']:>7.1f}"
+        f"{rec['eval_success_final']:>6.3f} {rec['eval_return']:>7.2f}{extra} {rec['wall_s']:>7.1f}"
+    )
+
+
+def sweep_line(recs: list[dict], total_iterations: int) -> str:
+    """The members' mean and best success after a chunk of a sweep."""
+    mean = sum(r["eval_success"] for r in recs) / len(recs)
+    best = max(r["eval_success"] for r in recs)
+    final = sum(r["eval_success_final"] for r in recs) / len(recs)
+    return (
+        f"iter {recs[0]['iteration']:>5}/{total_iterations}  mean success {mean:.3f} (final step {final:.3f})  "
+        f"best {best:.3f}  steps/s per member {_si(recs[0]['steps_per_s'])}  wall {recs[0]['wall_s']:.1f}s"
     )
 
 

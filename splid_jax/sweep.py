@@ -1,28 +1,31 @@
 """``python -m splid_jax.sweep``: seeds x sigma x H as ONE compiled program.
 
-Every member is a lane of ``jax.vmap`` over the chunk function: seeds differ by PRNG key, sigma and
-H by the traced ``Hyper`` (H masks candidates up to the largest H of the grid), so a grid costs
-one compilation and runs in lock-step on the device."""
+Every member is a lane of ``jax.vmap`` over the chunk function (``splid_jax.loop``): seeds differ by
+PRNG key, sigma and H by the traced hyper-parameters (H masks candidates up to the largest H of the
+grid), so a grid costs one compilation and runs in lock-step on the device. Each member writes its
+own config.json and metrics.jsonl under RUN_DIR/<member>; the members' stacked state is checkpointed
+under RUN_DIR, so ``--resume RUN_DIR`` continues a sweep as it continues a run."""
 
 from __future__ import annotations
 
-import argparse
-import dataclasses
-import itertools
-import json
-import os
-import sys
-import time
+from splid_jax.cli import quiet_interrupts
 
-import jax
-import jax.numpy as jnp
+if __name__ == "__main__":  # a signal while JAX loads ends the process with one line, no traceback
+    quiet_interrupts()
 
-from envs.base import InvalidConfig, check
-from splid_jax import plot, progress
-from splid_jax.cli import add_compile_cache_flag, add_config_flags, explicit_values, use_compile_cache
-from splid_jax.config import TASK_DEFAULTS, TrainConfig
-from splid_jax.train import make_env, pop_select_steps
-from splid_jax.trainer import Hyper, Trainer
+import dataclasses  # noqa: E402
+import itertools  # noqa: E402
+import json  # noqa: E402
+import math  # noqa: E402
+import os  # noqa: E402
+import re  # noqa: E402
+import sys  # noqa: E402
+
+from envs.base import InvalidConfig, check  # noqa: E402
+from splid_jax import checkpoint, loop, plot, progress  # noqa: E402
+from splid_jax.cli import Parser, add_compile_cache_flag, add_config_flags, explicit_values, use_compile_cache  # noqa: E402
+from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.loop import RunStopped, make_env  # noqa: E402
 
 
 @dataclasses.dataclass(frozen=True)
@@ -38,91 +41,127 @@ class Member:
 
 def members(seeds: int, sigmas: tuple[float, ...], horizons: tuple[int, ...], base_seed: int = 0) -> list[Member]:
     check(seeds >= 1, "seeds", seeds, "an integer >= 1")
-    check(len(sigmas) >= 1 and min(sigmas) >= 0, "sigmas", sigmas, "one or more values >= 0")
+    ok = len(sigmas) >= 1 and all(math.isfinite(s) and s >= 0 for s in sigmas)
+    check(ok, "sigmas", sigmas, "one or more finite values >= 0")
     check(len(horizons) >= 1 and min(horizons) >= 1, "horizons", horizons, "one or more integers >= 1")
     return [Member(base_seed + s, float(sg), int(h)) for sg, h, s in itertools.product(sigmas, horizons, range(seeds))]
 
 
-def run_sweep(cfg: TrainConfig, grid: list[Member], quiet: bool = False) -> list[dict]:
-    """Train every member of ``grid`` in lock-step; returns each member's last metrics record."""
-    env = make_env(cfg.env, **cfg.env_overrides())
-    max_h = max(m.horizon for m in grid)
-    trainer = Trainer(env, dataclasses.replace(cfg, horizon=max_h))
-    keys = jnp.stack([jax.random.PRNGKey(m.seed) for m in grid])
-    hyper = Hyper(
-        sigma=jnp.asarray([m.sigma for m in grid], jnp.float32),
-        horizon=jnp.asarray([m.horizon for m in grid], jnp.int32),
-    )
-    state = jax.jit(jax.vmap(trainer.init))(keys)
-    chunk = jax.jit(jax.vmap(trainer.chunk))
-    dirs = [os.path.join(cfg.run_dir, m.name) for m in grid]
-    for d, m in zip(dirs, grid, strict=True):
-        os.makedirs(d, exist_ok=True)
-        with open(os.path.join(d, "config.json"), "w") as fh:
-            json.dump({**cfg.to_json(), "seed": m.seed, "sigma": m.sigma, "horizon": m.horizon, "run_dir": d}, fh)
-        open(os.path.join(d, "metrics.jsonl"), "w").close()
-    progress.show(f"sweep: {len(grid)} members of {cfg.env} in one program, {cfg.iterations} iterations", quiet)
-    start, iteration, last = time.perf_counter(), 0, []
-    totals = [0] * len(grid)  # SELECT replay steps per member, exact Python ints
-    while iteration < cfg.iterations:
-        t0 = time.perf_counter()
-        state, metrics = chunk(state, hyper)
-        metrics = jax.device_get(metrics)
-        chunk_s, iteration = time.perf_counter() - t0, iteration + cfg.eval_every
-        wall = time.perf_counter() - start
-        last = []
-        per_member = pop_select_steps(metrics)
-        for i, d in enumerate(dirs):
-            totals[i] += int(per_member[i])
-            rec = trainer.counters(iteration, totals[i])
-            rec.update({k: v[i].item() for k, v in metrics.items() if k != "finite"})
-            rec.update(finite=bool(metrics["finite"][i]), wall_s=wall, chunk_s=chunk_s)
-            with open(os.path.join(d, "metrics.jsonl"), "a") as fh:
-                fh.write(json.dumps(rec) + "\n")
-            last.append(rec)
-        best = max(last, key=lambda r: r["eval_success"])
-        progress.show(
-            f"iter {iteration:>5}/{cfg.iterations}  mean success {sum(r['eval_success'] for r in last) / len(last):.3f}"
-            f"  best {best['eval_success']:.3f}  chunk {chunk_s:.1f}s  wall {wall:.1f}s",
-            quiet,
+def member_configs(cfg: TrainConfig, grid: list[Member]) -> tuple[TrainConfig, list[TrainConfig]]:
+    """The sweep's config (shapes for the largest H) and each member's, in RUN_DIR/<member>."""
+    base = dataclasses.replace(cfg, horizon=max(m.horizon for m in grid))
+    lanes = [
+        dataclasses.replace(
+            base, seed=m.seed, sigma=m.sigma, horizon=m.horizon, run_dir=os.path.join(cfg.run_dir, m.name)
         )
-    return last
+        for m in grid
+    ]
+    return base, lanes
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(
+def run_sweep(cfg: TrainConfig, grid: list[Member], quiet: bool = False, resume: bool = False) -> list[dict]:
+    """Train every member of ``grid`` in lock-step; returns each member's last metrics record."""
+    base, lanes = member_configs(cfg, grid)
+    env = make_env(base.env, **base.env_overrides())
+    base.check_env(env)
+    return loop.run(base, env, members=lanes, resume=resume, quiet=quiet)
+
+
+def _values(field: str, text: str, kind: type) -> tuple:
+    words = [w.strip() for w in text.split(",")]
+    try:
+        return tuple(kind(w) for w in words)
+    except ValueError:
+        what = "integers" if kind is int else "numbers"
+        raise InvalidConfig(field, text, f"comma-separated {what}, e.g. {'2,8' if kind is int else '0.5,1'}") from None
+
+
+def _join_negative(argv: list[str]) -> list[str]:
+    """``--sigmas -1,1`` as ``--sigmas=-1,1``: argparse takes a leading minus for a flag, and the
+    value's range check then names the field."""
+    out, skip = [], False
+    for i, word in enumerate(argv):
+        if skip:
+            skip = False
+        elif word in ("--sigmas", "--horizons") and i + 1 < len(argv) and re.fullmatch(r"-[\d.][\d.,\-]*", argv[i + 1]):
+            out.append(f"{word}={argv[i + 1]}")
+            skip = True
+        else:
+            out.append(word)
+    return out
+
+
+def build_parser() -> Parser:
+    parser = Parser(
         prog="python -m splid_jax.sweep",
         description="Run a grid of seeds x sigma x H as one vmapped, compiled program; one metrics file per member.",
+        epilog="Exit codes as train's: 0 done, 2 bad input (nothing written), 3 stopped, 130 Ctrl-C, 143 SIGTERM.",
     )
-    # --sigmas and --horizons replace the single values (--sigma and --horizon abbreviate them);
-    # a sweep keeps no checkpoints
-    add_config_flags(parser, TrainConfig, TASK_DEFAULTS, exclude=frozenset({"sigma", "horizon", "checkpoint_every"}))
+    # --sigmas and --horizons replace the single values
+    add_config_flags(parser, TrainConfig, TASK_DEFAULTS, exclude=frozenset({"sigma", "horizon"}))
     parser.add_argument("--seeds", type=int, default=4, help="seeds per grid point (default: 4)")
     parser.add_argument("--sigmas", default="1.0", help="comma-separated sigma values (default: 1.0)")
     parser.add_argument("--horizons", default="8", help="comma-separated H values (default: 8)")
+    parser.add_argument("--resume", metavar="RUN_DIR", help="continue the sweep saved in RUN_DIR (its sweep.json)")
     parser.add_argument("--no-plot", action="store_true", help="skip the grid figure")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_compile_cache_flag(parser)
-    ns = parser.parse_args(argv)
+    return parser
+
+
+def resume_configs(run_dir: str, given: dict) -> tuple[TrainConfig, list[TrainConfig]]:
+    """The sweep's and its members' configs from RUN_DIR/sweep.json; only ``MAY_CHANGE_ON_RESUME``
+    fields (iterations, checkpoint_every) may be given anew."""
+    changed = [k for k in given if k not in loop.MAY_CHANGE_ON_RESUME]
+    if changed:
+        raise InvalidConfig(changed[0], given[changed[0]], "as in the sweep being resumed (only iterations may change)")
+    try:
+        with open(os.path.join(run_dir, loop.SWEEP)) as fh:
+            saved = json.load(fh)
+        base = TrainConfig(**{**saved["config"], **given, "run_dir": run_dir})
+        lanes = [
+            TrainConfig(**{**m, **given, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in saved["members"]
+        ]
+    except (OSError, json.JSONDecodeError, KeyError, TypeError):
+        raise InvalidConfig("resume", run_dir, f"a sweep directory holding its {loop.SWEEP}") from None
+    return base, lanes
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    ns = parser.parse_args(_join_negative(sys.argv[1:] if argv is None else argv))
     use_compile_cache(ns.compile_cache)
     try:
         given = explicit_values(TrainConfig, ns)
-        given.setdefault("run_dir", os.path.join("runs", f"sweep-{given.get('env', 'point')}"))
-        sigmas = tuple(float(x) for x in ns.sigmas.split(","))
-        horizons = tuple(int(x) for x in ns.horizons.split(","))
-        grid = members(ns.seeds, sigmas, horizons, base_seed=given.get("seed", 0))
-        cfg = TrainConfig(**{**given, "horizon": max(horizons), "sigma": max(sigmas)})
-        cfg.check_env(make_env(cfg.env, **cfg.env_overrides()))
-    except (InvalidConfig, ValueError) as err:
+        if ns.resume:
+            cfg, lanes = resume_configs(ns.resume, given)
+        else:
+            given.setdefault("run_dir", os.path.join("runs", f"sweep-{given.get('env', 'point')}"))
+            sigmas, horizons = _values("sigmas", ns.sigmas, float), _values("horizons", ns.horizons, int)
+            grid = members(ns.seeds, sigmas, horizons, base_seed=given.get("seed", 0))
+            cfg, lanes = member_configs(TrainConfig(**{**given, "horizon": max(horizons), "sigma": max(sigmas)}), grid)
+        env = make_env(cfg.env, **cfg.env_overrides())
+        cfg.check_env(env)
+        loop.run(cfg, env, members=lanes, resume=bool(ns.resume), quiet=ns.quiet)
+    except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 2
-    run_sweep(cfg, grid, ns.quiet)
+    except loop.Interrupted as stop:
+        return stop.exit_code
+    except (RunStopped, checkpoint.CheckpointError) as err:
+        print(f"{parser.prog}: error: {err}", file=sys.stderr)
+        return 3
     if not ns.no_plot:
         out = os.path.join(cfg.run_dir, "grid.png")
-        plot.main([os.path.join(cfg.run_dir, m.name) for m in grid] + ["--group", "--out", out])
+        plot.main([m.run_dir for m in lanes] + ["--group", "--out", out])
         progress.show(f"figure: {out}", ns.quiet)
     return 0
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    code = main()
+    if code in (130, 143):  # the chunk or compilation the signal cut short may still run in a thread
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    raise SystemExit(code)

@@ -1,181 +1,43 @@
-"""``python -m splid_jax.train --env ENV``: train SPLID, log, checkpoint, resume.
+"""``python -m splid_jax.train --env ENV``: train one run through the host loop (``splid_jax.loop``).
 
-Python runs only between compiled chunks: it logs, writes metrics.jsonl and saves checkpoints."""
+Exit codes: 0 done (or already complete), 2 a mistake in the command line (one line naming the
+field, nothing written), 3 stopped (NaN, unreadable checkpoint), 130 Ctrl-C, 143 SIGTERM; a stop
+by signal keeps the newest whole state as a checkpoint to --resume from."""
 
 from __future__ import annotations
 
-import argparse
-import contextlib
-import io
-import json
-import os
-import signal
-import sys
-import threading
-import time
+from splid_jax.cli import quiet_interrupts
 
-import jax
-import numpy as np
+if __name__ == "__main__":  # a signal while JAX loads ends the process with one line, no traceback
+    quiet_interrupts()
 
-import envs
-from envs.base import InvalidConfig
-from splid_jax import checkpoint, progress
-from splid_jax.cli import add_compile_cache_flag, add_config_flags, explicit_values, use_compile_cache
-from splid_jax.config import TASK_DEFAULTS, TrainConfig, saved_fields
-from splid_jax.trainer import Trainer
+import argparse  # noqa: E402
+import dataclasses  # noqa: E402
+import json  # noqa: E402
+import os  # noqa: E402
+import sys  # noqa: E402
 
-# Fields a resumed run must share with its checkpoint; the rest may change on resume.
-_MAY_CHANGE_ON_RESUME = {"iterations", "run_dir", "checkpoint_every"}
+import envs  # noqa: E402
+from envs.base import InvalidConfig  # noqa: E402
+from splid_jax import checkpoint, loop, progress  # noqa: E402
+from splid_jax.cli import Parser, add_compile_cache_flag, add_config_flags, explicit_values, use_compile_cache  # noqa: E402
+from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.loop import MAY_CHANGE_ON_RESUME, RunStopped, env_settings, make_env  # noqa: E402
 
-
-class RunStopped(RuntimeError):
-    """The run stopped early for a reason the user must see (NaN); exit code 3."""
-
-
-def make_env(name: str, **overrides) -> envs.GoalEnv:
-    with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
-        return envs.make(name, **overrides)
-
-
-def _identity(cfg: TrainConfig) -> dict:
-    """The settings a checkpoint must share with the run resuming it, as JSON stores them."""
-    ident = {k: v for k, v in cfg.to_json().items() if k not in _MAY_CHANGE_ON_RESUME}
-    if not ident["env_options"]:  # absent from runs saved before the field existed; "" means the same
-        del ident["env_options"]
-    return json.loads(json.dumps(ident))
-
-
-def env_settings(env: envs.GoalEnv) -> dict:
-    """The task's every option as JSON stores it: a resume under other task defaults fails naming one."""
-    return json.loads(json.dumps(env.settings()))
-
-
-def pop_select_steps(metrics: dict) -> np.ndarray:
-    """Pops a chunk's per-iteration SELECT replay steps ([..., eval_every], int32 on the device) and
-    sums them over the iterations in int64 (per member of a sweep, where there is a member axis)."""
-    return np.asarray(metrics.pop("select_steps"), np.int64).sum(axis=-1)
-
-
-def _record(
-    trainer: Trainer, metrics: dict, wall_s: float, chunk_s: float, iteration: int, total: int, chunk_steps: int
-) -> dict:
-    """One metrics line; ``total`` SELECT replay steps in the run so far, ``chunk_steps`` in this chunk."""
-    rec = trainer.counters(iteration, total)
-    for k, v in metrics.items():
-        rec[k] = v.item()
-    chunk = trainer.counters(trainer.cfg.eval_every, chunk_steps)
-    steps = chunk["env_steps"] + chunk["select_steps"]
-    rec["buffer_fill"] = rec["buffer_size"] / trainer.cfg.buffer_size
-    rec["steps_per_s"] = steps / max(chunk_s, 1e-9)
-    rec["wall_s"] = wall_s
-    return rec
+__all__ = ["RunStopped", "build_parser", "config_from_cli", "env_settings", "main", "make_env", "run"]
 
 
 def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False, quiet: bool = False) -> dict:
-    """Train to ``cfg.iterations``; returns the last metrics record. Resumes from the newest
-    checkpoint in ``cfg.run_dir`` when ``resume``."""
-    env = env or make_env(cfg.env, **cfg.env_overrides())
-    trainer = Trainer(env, cfg)
-    chunk = jax.jit(trainer.chunk)
-    os.makedirs(cfg.run_dir, exist_ok=True)
-    metrics_path = os.path.join(cfg.run_dir, "metrics.jsonl")
-    state = trainer.init(jax.random.PRNGKey(cfg.seed))
-    wall_before, select_steps = 0.0, 0
-    if resume:
-        # the meta check comes first, so a changed setting is named rather than a leaf's shape
-        step, state, meta = checkpoint.restore(cfg.run_dir, state, expect_meta={"config": _identity(cfg)},
-                                               expect_meta_if_saved={"env": env_settings(env)})
-        wall_before = float(meta["wall_s"])
-        kept = [r for r in _read_jsonl(metrics_path) if r["iteration"] <= step]
-        select_steps = int(meta["select_steps"])
-        _write_jsonl(metrics_path, kept)
-        progress.show(f"resumed {cfg.run_dir} at iteration {step}", quiet)
-    else:
-        open(metrics_path, "w").close()
-    with open(os.path.join(cfg.run_dir, "config.json"), "w") as fh:
-        json.dump(cfg.to_json(), fh, indent=2)
-
-    hyper = trainer.hyper()
-    iteration = int(state.iteration)
-    progress.show(f"splid_jax: env={cfg.env} select={cfg.select} device={jax.devices()[0].platform}", quiet)
-    progress.show(progress.HEADER, quiet)
-    start = time.perf_counter()
-    rec, chunks_done = {}, 0
-
-    def save(st, it, total):
-        meta = {"config": _identity(cfg), "env": env_settings(env),
-                "wall_s": wall_before + time.perf_counter() - start, "select_steps": total}
-        with _interrupt_after():
-            checkpoint.save(cfg.run_dir, it, st, meta)
-
-    try:
-        while iteration < cfg.iterations:
-            t0 = time.perf_counter()
-            new_state, metrics = chunk(state, hyper)
-            metrics = jax.device_get(metrics)
-            chunk_s = time.perf_counter() - t0
-            if not bool(metrics.pop("finite")):
-                raise RunStopped(
-                    f"non-finite loss or parameters after iteration {iteration + cfg.eval_every}; "
-                    f"stopped, the last good checkpoint (iteration {iteration}) is kept in {cfg.run_dir}"
-                )
-            done = iteration + cfg.eval_every
-            chunk_steps = int(pop_select_steps(metrics))
-            new_total = select_steps + chunk_steps
-            rec = _record(
-                trainer, metrics, wall_before + time.perf_counter() - start, chunk_s, done, new_total, chunk_steps
-            )
-            with open(metrics_path, "a") as fh:  # a line past the checkpoint is dropped on resume
-                fh.write(json.dumps(rec) + "\n")
-            state, iteration, chunks_done, select_steps = new_state, done, chunks_done + 1, new_total
-            progress.show(progress.line(rec, cfg.iterations), quiet)
-            if iteration == cfg.iterations or (cfg.checkpoint_every and chunks_done % cfg.checkpoint_every == 0):
-                save(state, iteration, select_steps)
-    except KeyboardInterrupt:
-        if checkpoint.latest_step(cfg.run_dir) != iteration:
-            save(state, iteration, select_steps)
-        progress.show(f"interrupted: saved iteration {iteration} to {cfg.run_dir}; resume with --resume", quiet)
-        raise
-    except RunStopped:
-        if checkpoint.latest_step(cfg.run_dir) != iteration:
-            save(state, iteration, select_steps)
-        raise
-    return rec
-
-
-@contextlib.contextmanager
-def _interrupt_after():
-    """Holds a Ctrl-C that comes during the block until the block is done: an interrupted orbax save
-    leaves a temporary directory that the save on the way out cannot replace."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    caught = []
-    previous = signal.signal(signal.SIGINT, lambda *_: caught.append(True))
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    if caught:
-        raise KeyboardInterrupt
-
-
-def _read_jsonl(path: str) -> list[dict]:
-    if not os.path.exists(path):
-        return []
-    with open(path) as fh:
-        return [json.loads(line) for line in fh if line.strip()]
-
-
-def _write_jsonl(path: str, records: list[dict]) -> None:
-    with open(path, "w") as fh:
-        fh.writelines(json.dumps(r) + "\n" for r in records)
+    """Train one run to ``cfg.iterations``; returns its last metrics record."""
+    return loop.run(cfg, env, resume=resume, quiet=quiet)[0]
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="python -m splid_jax.train",
-        description="Train SPLID (explore, SELECT by first hit time, behaviour cloning) on a goal-conditioned task.",
+        description="Train a goal-conditioned policy (SPLID: explore, SELECT by first hit time, behaviour cloning).",
+        epilog="Exit codes: 0 done, 2 bad input (nothing written), 3 stopped on NaN or an unreadable checkpoint, "
+        "130 Ctrl-C, 143 SIGTERM (both keep the newest whole state as a checkpoint for --resume).",
     )
     add_config_flags(parser, TrainConfig, TASK_DEFAULTS)
     parser.add_argument("--resume", metavar="RUN_DIR", help="continue the run saved in RUN_DIR (its config.json)")
@@ -187,17 +49,21 @@ def build_parser() -> argparse.ArgumentParser:
 def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
     given = explicit_values(TrainConfig, ns)
     if ns.resume is None:
-        cfg = TrainConfig(**given)
-        if os.path.isdir(cfg.run_dir) and checkpoint.latest_step(cfg.run_dir) is not None:
-            raise InvalidConfig("run_dir", cfg.run_dir, "a directory without a run in it (or pass --resume RUN_DIR)")
-        return cfg, False
+        return TrainConfig(**given), False
     path = os.path.join(ns.resume, "config.json")
     if not os.path.isfile(path):
         raise InvalidConfig("resume", ns.resume, "a run directory holding config.json")
-    with open(path) as fh:
-        saved = saved_fields(json.load(fh))
+    names = {f.name for f in dataclasses.fields(TrainConfig)}
+    try:
+        with open(path) as fh:
+            saved = json.load(fh)
+        unknown = sorted(set(saved) - names) if isinstance(saved, dict) else ["(not an object)"]
+    except (OSError, json.JSONDecodeError):
+        unknown = ["(not JSON)"]
+    if unknown:
+        raise InvalidConfig("resume", ns.resume, f"a run whose config.json this version wrote (it has {unknown[0]})")
     for k, v in given.items():
-        if k not in _MAY_CHANGE_ON_RESUME and v != saved.get(k) and not (isinstance(v, tuple) and list(v) == saved[k]):
+        if k not in MAY_CHANGE_ON_RESUME and v != saved.get(k) and not (isinstance(v, tuple) and list(v) == saved[k]):
             raise InvalidConfig(k, v, f"{saved.get(k)!r} as in the run being resumed (only iterations may change)")
     saved.update(given, run_dir=ns.resume)
     return TrainConfig(**saved), True
@@ -211,15 +77,12 @@ def main(argv: list[str] | None = None) -> int:
         cfg, resume = config_from_cli(ns)
         env = make_env(cfg.env, **cfg.env_overrides())
         cfg.check_env(env)
-        if resume and checkpoint.latest_step(cfg.run_dir) is None:
-            raise InvalidConfig("resume", cfg.run_dir, "a run directory holding a checkpoint")
+        rec = run(cfg, env, resume=resume, quiet=ns.quiet)
     except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 2
-    try:
-        rec = run(cfg, env, resume=resume, quiet=ns.quiet)
-    except KeyboardInterrupt:
-        return 130
+    except loop.Interrupted as stop:
+        return stop.exit_code
     except (RunStopped, checkpoint.CheckpointError) as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 3
@@ -233,5 +96,9 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    np.set_printoptions(precision=4)
-    raise SystemExit(main())
+    code = main()
+    if code in (130, 143):  # the chunk or compilation the signal cut short may still run in a thread
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    raise SystemExit(code)

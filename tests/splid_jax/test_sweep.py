@@ -35,8 +35,41 @@ def test_cli_rejects_a_bad_grid(capsys, tmp_path):
     assert not (tmp_path / "x").exists()
 
 
-def test_cli_refuses_checkpoint_every_which_a_sweep_would_ignore(capsys, tmp_path):
-    with pytest.raises(SystemExit) as exc:
-        sweep.main(["--env", "point", "--checkpoint-every", "1", "--run-dir", str(tmp_path / "x")])
-    assert exc.value.code == 2 and "--checkpoint-every" in capsys.readouterr().err
+@pytest.mark.parametrize(
+    "args, field",
+    [
+        (["--sigmas", ""], "sigmas"),
+        (["--sigmas", "a,b"], "sigmas"),
+        (["--sigmas", "-1,1"], "sigmas"),
+        (["--sigmas", "inf"], "sigmas"),
+        (["--horizons", "2.5"], "horizons"),
+        (["--seed", "-1"], "seed"),
+    ],
+)
+def test_cli_names_the_field_of_a_bad_value(capsys, tmp_path, args, field):
+    assert sweep.main(["--env", "point", *args, "--run-dir", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
     assert not (tmp_path / "x").exists()
+
+
+def test_cli_refuses_abbreviated_flags(capsys, tmp_path):
+    with pytest.raises(SystemExit) as exc:
+        sweep.main(["--env", "point", "--sigma", "1", "--run-dir", str(tmp_path / "x")])
+    assert exc.value.code == 2 and "--sigma" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
+
+
+def test_a_second_sweep_into_one_dir_is_refused_and_a_sweep_resumes(capsys, tmp_path):
+    args = ["--env", "point", "--num-envs", "4", "--eval-episodes", "8", "--eval-every", "2", "--bc-steps", "5",
+            "--batch-size", "16", "--hidden", "16", "--seeds", "2", "--horizons", "4", "--no-plot",
+            "--quiet"]  # fmt: skip
+    run_dir = str(tmp_path / "sweep")
+    assert sweep.main([*args, "--iterations", "2", "--run-dir", run_dir]) == 0
+    kept = read(tmp_path / "sweep" / "sigma1-H4-s0" / "metrics.jsonl")
+    assert sweep.main([*args, "--iterations", "4", "--sigmas", "0.5", "--run-dir", run_dir]) == 2
+    assert "run_dir" in capsys.readouterr().err
+    assert read(tmp_path / "sweep" / "sigma1-H4-s0" / "metrics.jsonl") == kept
+    assert sweep.main(["--resume", run_dir, "--iterations", "4", "--no-plot", "--quiet"]) == 0
+    recs = read(tmp_path / "sweep" / "sigma1-H4-s1" / "metrics.jsonl")
+    assert [r["iteration"] for r in recs] == [2, 4]

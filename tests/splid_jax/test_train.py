@@ -1,5 +1,6 @@
-"""The command line and its run directory: bad input, resume after a real kill, Ctrl-C, NaN,
-corrupt and mismatched checkpoints. All on the point task, in subprocesses where a signal is real."""
+"""The command line and its run directory: bad input, resume after a real kill, Ctrl-C and SIGTERM at
+any moment, NaN, corrupt and mismatched checkpoints. All on the point task, in subprocesses where a
+signal is real."""
 
 import json
 import os
@@ -14,7 +15,7 @@ import pytest
 
 from splid_jax import checkpoint
 from splid_jax.config import TrainConfig
-from splid_jax.train import RunStopped, _interrupt_after, main, run
+from splid_jax.train import RunStopped, main, run
 from splid_jax.trainer import Trainer
 
 TINY = ["--env", "point", "--num-envs", "8", "--eval-episodes", "16", "--bc-steps", "40", "--batch-size", "64",
@@ -66,6 +67,13 @@ def final_params(run_dir):
         (["--env-options", "success_radius"], "env_options"),
         (["--env-options", "bogus=1"], "point.bogus"),
         (["--env-options", "max_episode_steps=8"], "horizon"),  # H = 8 must stay below the episode length
+        (["--env-options", "max_episode_steps=abc"], "point.max_episode_steps"),
+        (["--env-options", "success_radius=big"], "point.success_radius"),
+        (["--env-options", "max_episode_steps=20.5"], "point.max_episode_steps"),
+        (["--seed", "99999999999999999999"], "seed"),
+        (["--sigma", "inf"], "sigma"),
+        (["--sigma", "nan"], "sigma"),
+        (["--num-envs", "100000000"], "num_envs"),  # refused from its shapes, before anything is allocated
     ],
 )
 def test_bad_values_stop_before_any_work(tmp_path, capsys, args, field):
@@ -74,6 +82,27 @@ def test_bad_values_stop_before_any_work(tmp_path, capsys, args, field):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and field in err
     assert not run_dir.exists()
+
+
+def test_abbreviated_flags_are_not_taken_for_others(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--learning-rat", "0.1", "--run-dir", str(tmp_path / "run")])
+    assert exc.value.code == 2 and "--learning-rat" in capsys.readouterr().err
+    assert not (tmp_path / "run").exists()
+
+
+def test_a_run_dir_under_proc_is_refused(capsys):
+    assert main(["--run-dir", "/proc/splid-run"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "run_dir" in err and "writable" in err
+
+
+def test_env_options_help_lists_every_tasks_fields(capsys):
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "point: max_episode_steps=50, success_radius=1.0" in out
+    assert "push: " in out and "distance_threshold=0.05" in out and "slide: as " in out
 
 
 def test_run_dir_that_is_a_file_is_refused(tmp_path, capsys):
@@ -138,10 +167,10 @@ def test_ctrl_c_saves_and_exits_cleanly(tmp_path):
     while (checkpoint.latest_step(run_dir) or 0) < 5 and proc.poll() is None and time.time() < deadline:
         time.sleep(0.02)
     proc.send_signal(signal.SIGINT)
-    out, _ = proc.communicate(timeout=120)
-    assert proc.returncode == 130
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130 and "Traceback" not in err
     step = checkpoint.latest_step(run_dir)
-    assert "interrupted: saved iteration" in out and f"iteration {step} " in out
+    assert "interrupted (SIGINT): saved iteration" in out and f"iteration {step} " in out
     # the checkpoint holds the last finished chunk; metrics may be one chunk ahead, dropped on resume
     assert step >= 5 and step <= stable(run_dir)[-1]["iteration"] <= step + 5
 
@@ -191,18 +220,6 @@ def test_env_options_build_the_task_the_run_trains_on(tmp_path):
     assert rec["env_steps"] == 5 * 4 * 20  # episodes of the overridden length
 
 
-def test_ctrl_c_during_a_checkpoint_write_waits_for_the_write(tmp_path):
-    state = {"w": np.arange(4.0)}
-    with pytest.raises(KeyboardInterrupt):
-        with _interrupt_after():
-            os.kill(os.getpid(), signal.SIGINT)
-            time.sleep(0.05)  # the signal is handled in here, and held
-            checkpoint.save(str(tmp_path), 5, state, {"config": {}})
-    assert checkpoint.latest_step(str(tmp_path)) == 5  # written whole, then the interrupt came
-    _, restored, _ = checkpoint.restore(str(tmp_path), state)
-    np.testing.assert_array_equal(restored["w"], state["w"])
-
-
 def test_resume_under_changed_task_defaults_fails_naming_the_option(tmp_path):
     # the same config both times; only the task itself differs, as after a change of its defaults
     import envs
@@ -215,3 +232,69 @@ def test_resume_under_changed_task_defaults_fails_naming_the_option(tmp_path):
     with pytest.raises(CheckpointError, match=r"env\.door_half_width=0\.75 but env\.door_half_width=0\.5"):
         run(longer, env=envs.make("point", door_half_width=0.5), resume=True, quiet=True)
     assert run(longer, env=envs.make("point"), resume=True, quiet=True)["iteration"] == 10
+
+
+def test_resume_to_fewer_iterations_is_refused_and_a_finished_run_is_complete(tmp_path, capsys):
+    run_dir = tmp_path / "run"
+    assert main([*TINY, "--iterations", "10", "--run-dir", str(run_dir), "--quiet"]) == 0
+    files = {p: (run_dir / p).read_bytes() for p in ("config.json", "metrics.jsonl")}
+    capsys.readouterr()
+    assert main(["--resume", str(run_dir), "--iterations", "5"]) == 2
+    err = capsys.readouterr().err
+    assert "iterations=5" in err and ">= 10" in err
+    assert main(["--resume", str(run_dir)]) == 0
+    assert "already complete" in capsys.readouterr().out
+    assert {p: (run_dir / p).read_bytes() for p in files} == files
+
+
+def test_metrics_without_a_checkpoint_are_not_overwritten(tmp_path, capsys):
+    run_dir = tmp_path / "run"
+    run_dir.mkdir()
+    (run_dir / "metrics.jsonl").write_text('{"iteration": 5}\n' * 30)
+    assert main([*TINY, "--iterations", "5", "--run-dir", str(run_dir)]) == 2
+    assert "run_dir" in capsys.readouterr().err
+    assert (run_dir / "metrics.jsonl").read_text() == '{"iteration": 5}\n' * 30
+
+
+def wait_for(proc, text):
+    """Reads the run's stdout up to the first line holding ``text``."""
+    for line in proc.stdout:
+        if text in line:
+            return
+    raise AssertionError(f"the run ended before printing {text!r}: {proc.stderr.read()}")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["SIGINT", "SIGTERM"])
+def test_a_signal_during_the_first_compilation_exits_cleanly(tmp_path, sig, code):
+    run_dir = str(tmp_path / "run")
+    proc = cli(*TINY, "--iterations", "10", "--run-dir", run_dir, "--compile-cache", "")
+    wait_for(proc, "compiling")
+    proc.send_signal(sig)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == code, err
+    assert "Traceback" not in err and "interrupted" in out and "nothing saved" in out
+    assert checkpoint.latest_step(run_dir) is None
+
+
+def test_a_signal_within_the_first_second_exits_cleanly(tmp_path):
+    proc = cli(*TINY, "--run-dir", str(tmp_path / "run"))
+    time.sleep(0.5)  # JAX is still loading
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "Traceback" not in err and "interrupted" in err
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.slow
+def test_sigterm_saves_like_ctrl_c_and_the_run_resumes(tmp_path):
+    run_dir = str(tmp_path / "run")
+    proc = cli(*TINY, "--iterations", "1000", "--checkpoint-every", "0", "--run-dir", run_dir)
+    wait_for(proc, " 10/1000")
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 143 and "Traceback" not in err
+    step = checkpoint.latest_step(run_dir)
+    assert step >= 10 and f"saved iteration {step} " in out
+    assert main(["--resume", run_dir, "--iterations", str(step + 5), "--quiet"]) == 0
+    assert [r["iteration"] for r in stable(run_dir)] == list(range(5, step + 10, 5))
