@@ -183,13 +183,11 @@ def restore(
     like_state: Any,
     expect_meta: Mapping[str, Any] | None = None,
     step: int | None = None,
-    expect_meta_if_saved: Mapping[str, Any] | None = None,
 ) -> tuple[int, Any, dict[str, Any]]:
     """Load checkpoint ``step`` (default: newest) into the structure, shapes and dtypes of ``like_state``.
 
     ``like_state`` may be concrete or abstract (``jax.eval_shape``). Returns ``(step, state, meta)``.
-    ``expect_meta`` must match the saved meta; ``expect_meta_if_saved`` only where the saved meta has
-    its top-level keys (settings recorded since some version: older checkpoints lack them).
+    ``expect_meta`` must match the saved meta (its keys; the saved meta may hold more).
     Every failure is a one-line ``CheckpointError`` so the trainer can print it and stop.
     """
     directory = checkpoint_dir(run_dir)
@@ -218,10 +216,8 @@ def restore(
             raise corrupt(e) from e
         if not isinstance(meta, dict):
             raise corrupt(f"meta is {type(meta).__name__}, not a dict")
-        expected = dict(expect_meta or {})
-        expected.update({k: v for k, v in (expect_meta_if_saved or {}).items() if k in meta})
-        if expected:
-            diff = _first_meta_diff(meta, json.loads(json.dumps(expected)))
+        if expect_meta:
+            diff = _first_meta_diff(meta, json.loads(json.dumps(dict(expect_meta))))
             if diff is not None:
                 key, have, want = diff
                 raise CheckpointError(f"{where} was saved with {key}={_show(have)} but {key}={_show(want)} is expected")

@@ -125,17 +125,6 @@ class TrainConfig:
         return dataclasses.asdict(self)
 
 
-# Fields added after runs were already saved, with the value that those runs trained with.
-_BEFORE_FIELD_EXISTED: dict[str, Any] = {"policy_ema": 0.0}
-
-
-def saved_fields(saved: dict[str, Any]) -> dict[str, Any]:
-    """The ``TrainConfig`` fields of a saved ``config.json``: unknown keys dropped, and fields that
-    did not exist when it was written set to what that run did, not to today's task defaults."""
-    names = {f.name for f in dataclasses.fields(TrainConfig)}
-    return {**_BEFORE_FIELD_EXISTED, **{k: v for k, v in saved.items() if k in names}}
-
-
 ALGOS = ("splid", "gcsl", "pchid", "her", "es")
 RELABELS = ("paper", "hold")
 
