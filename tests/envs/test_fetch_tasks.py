@@ -1,9 +1,8 @@
 """Fetch-style MJX tasks: contract and shapes, sampling ranges, validation, rest without drift,
 restore-and-replay bit for bit, NaN flagging, action clipping, and scripted controllers succeeding.
 
-Compiling one MJX rollout takes 10-60 s on a 2-core CPU, so each task compiles exactly one program
-(``_program``: a scan of the batched step whose action is ``actions[t] + w * scripted(obs, goal)``)
-and every physics test reuses it at the same batch size and length.
+Every physics test steps a task through its one compiled episode program (the ``fetch`` fixture,
+conftest.FetchEpisodes), and the runs several tests read (rest, random actions, scripted) run once.
 """
 
 from __future__ import annotations
@@ -22,8 +21,6 @@ from envs.base import InvalidConfig
 from envs.fetch import models, scripted, tasks
 
 NAMES = ["reach", "push", "slide", "pick_and_place"]
-B = 8  # batch of every physics run
-T = 50  # steps of every physics run (one episode)
 K = 20  # restore point of the replay test
 
 
@@ -33,34 +30,21 @@ def _env(name):
 
 
 @functools.cache
-def _program(name):
-    env, ctl = _env(name), scripted.CONTROLLERS[name]
-
-    @jax.jit
-    def run(state, actions, w):
-        def body(s, a):
-            a = a + w[:, None] * ctl(s.obs, s.desired_goal)
-            s = jax.vmap(env.step)(s, a)
-            return s, s
-
-        return jax.lax.scan(body, state, actions)
-
-    return run
-
-
-@functools.cache
 def _reset(name, n):
     env = _env(name)
     return jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, n)))
 
 
-def _run(name, actions, w=0.0, state=None):
-    s0 = _reset(name, B)(jax.random.PRNGKey(0)) if state is None else state
-    return s0, *_program(name)(s0, jnp.asarray(actions, jnp.float32), jnp.full((B,), w, jnp.float32))
-
-
-def _random_actions(seed=1):
-    return jax.random.uniform(jax.random.PRNGKey(seed), (T, B, 4), minval=-1.0, maxval=1.0)
+@functools.cache
+def _episodes(fetch, name, kind):
+    """(start, final, trajectory) of a task's standing runs, each run once for every test reading it:
+    ``rest`` (zero action), ``random`` (uniform actions) or ``scripted`` (its controller)."""
+    zeros = np.zeros((fetch.T, fetch.B, 4))
+    if kind == "rest":
+        return fetch.run(_env(name), zeros)
+    if kind == "random":
+        return fetch.run(_env(name), fetch.random_actions(1))
+    return fetch.run(_env(name), zeros, w=1.0)
 
 
 def _at(tree, t):
@@ -71,26 +55,24 @@ def _at(tree, t):
 
 
 @pytest.mark.parametrize("name", NAMES)
-def test_contract_and_shapes_at_batch_2(name):
+def test_contract_and_shapes(fetch, name):
     env = _env(name)
     assert (env.goal_size, env.action_size, env.episode_length) == (3, 4, 50)
     assert env.obs_size == (10 if name == "reach" else 25)
     hash(env)  # jitted code closes over tasks: they must stay hashable
-    s = _reset(name, 2)(jax.random.PRNGKey(0))
-    chex.assert_shape(s.obs, (2, env.obs_size))
-    chex.assert_shape([s.achieved_goal, s.desired_goal], (2, 3))
-    chex.assert_shape([s.reward, s.success, s.step, s.invalid], (2,))
+    s, n = fetch.reset(env), fetch.B
+    chex.assert_shape(s.obs, (n, env.obs_size))
+    chex.assert_shape([s.achieved_goal, s.desired_goal], (n, 3))
+    chex.assert_shape([s.reward, s.success, s.step, s.invalid], (n,))
     lay = env.layout
-    chex.assert_shape(s.physics.qpos, (2, lay.nq))
-    chex.assert_shape([s.physics.qvel, s.physics.qacc_warmstart], (2, lay.nv))
-    chex.assert_shape(s.physics.ctrl, (2, lay.nu))
+    chex.assert_shape(s.physics.qpos, (n, lay.nq))
+    chex.assert_shape([s.physics.qvel, s.physics.qacc_warmstart], (n, lay.nv))
+    chex.assert_shape(s.physics.ctrl, (n, lay.nu))
     assert not bool(s.invalid.any()) and int(s.step.max()) == 0
-    # The step keeps every shape and dtype (traced only, not compiled).
-    out = jax.eval_shape(jax.vmap(env.step), s, jnp.zeros((2, 4)))
-    chex.assert_trees_all_equal_shapes_and_dtypes(out, s)
+    # (that the step keeps every shape and dtype: test_rests_without_drift_under_zero_action)
     # Achieved goal, layout and reward convention.
     np.testing.assert_array_equal(s.achieved_goal, s.obs[:, 0:3] if name == "reach" else s.obs[:, 3:6])
-    np.testing.assert_allclose(s.obs[:, 0:3], np.broadcast_to(lay.grip_home, (2, 3)), atol=1e-6)
+    np.testing.assert_allclose(s.obs[:, 0:3], np.broadcast_to(lay.grip_home, (n, 3)), atol=1e-6)
     np.testing.assert_array_equal(s.reward, env.reward_of(s.achieved_goal, s.desired_goal))
     near = jax.vmap(env.with_goal)(s, s.achieved_goal + jnp.asarray([0.0, 0.0, 0.049]))
     far = jax.vmap(env.with_goal)(s, s.achieved_goal + jnp.asarray([0.0, 0.0, 0.051]))
@@ -191,8 +173,9 @@ def test_arm_reach_barely_touches_push_pick_and_reach_goal_regions():
     # their robot stands 0.355 m nearer the table than Slide's: every goal, and the pushing gripper 6 cm
     # behind it, lies over 20 cm inside the reach, where a full 5 cm step outward loses under 10 %
     center, radius = np.asarray(models.ARM_REACH_CENTER_DEFAULT), models.ARM_REACH_RADIUS
-    g = np.stack(np.meshgrid(np.linspace(1.34 - 0.21, 1.34 + 0.15, 9), np.linspace(0.6, 0.9, 7),
-                             np.linspace(0.38, 0.9, 9)), -1).reshape(-1, 3)
+    g = np.stack(
+        np.meshgrid(np.linspace(1.34 - 0.21, 1.34 + 0.15, 9), np.linspace(0.6, 0.9, 7), np.linspace(0.38, 0.9, 9)), -1
+    ).reshape(-1, 3)
     assert (radius - np.linalg.norm(g - center, axis=1)).min() > 0.2
     for axis in range(3):
         steps = g + 0.05 * np.eye(3)[axis]
@@ -280,12 +263,18 @@ def test_drive_options_set_how_fast_the_gripper_follows_and_reject_nonpositive_v
     assert _grip_speed_after_jump(models.mjcf("slide", 0.004, 10, 4, drive_omega=70.0)) > 1.2 * base
     assert _grip_speed_after_jump(models.mjcf("slide", 0.004, 10, 4, drive_damping_ratio=1.5)) < 0.9 * base
     # gains scale with the mass (the drawn fingers' few grams aside), so a heavier gripper follows alike
-    np.testing.assert_allclose(_grip_speed_after_jump(models.mjcf("slide", 0.004, 10, 4, gripper_mass=20.0)), base,
-                               rtol=1e-3)
+    np.testing.assert_allclose(
+        _grip_speed_after_jump(models.mjcf("slide", 0.004, 10, 4, gripper_mass=20.0)), base, rtol=1e-3
+    )
     # the same damping as the actuators' explicit velocity feedback lets the gripper start faster
     assert _grip_speed_after_jump(models.mjcf("slide", 0.004, 10, 4, drive_damping="actuator")) > 1.1 * base
-    for field, bad in (("gripper_mass", 0.0), ("drive_omega", 0.0), ("drive_damping_ratio", 0.0),
-                       ("drive_damping", "tendon"), ("drive", "spring")):
+    for field, bad in (
+        ("gripper_mass", 0.0),
+        ("drive_omega", 0.0),
+        ("drive_damping_ratio", 0.0),
+        ("drive_damping", "tendon"),
+        ("drive", "spring"),
+    ):
         with pytest.raises(ValueError, match=field):
             models.mjcf("slide", **{field: bad})
 
@@ -304,28 +293,30 @@ def test_weld_drive_pulls_the_gripper_onto_its_mocap_target():
     np.testing.assert_allclose(d.qpos[g : g + 3], [0.05, -0.03, 0.02], atol=1e-3)
 
 
-# ---- physics: one compiled program per task --------------------------------------------------------
+# ---- physics: one compiled program per task (conftest.FetchEpisodes) -------------------------------
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
-def test_rests_without_drift_under_zero_action(name):
-    s0, _, traj = _run(name, np.zeros((T, B, 4)))
+def test_rests_without_drift_under_zero_action(fetch, name):
+    s0, final, traj = _episodes(fetch, name, "rest")
+    chex.assert_trees_all_equal_shapes_and_dtypes(final, s0)  # the step keeps every shape and dtype
     assert not bool(traj.invalid.any())
     drift = np.abs(np.asarray(traj.achieved_goal) - np.asarray(s0.achieved_goal)[None])
     assert drift.max() < 2e-3, drift.max()
-    np.testing.assert_array_equal(traj.step[-1], T)
+    np.testing.assert_array_equal(traj.step[-1], fetch.T)
     assert np.abs(np.asarray(traj.obs[-1])[:, -5:]).max() < 1e-3  # velocities settle
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
-def test_restore_and_replay_is_bitwise_exact(name):
-    acts = _random_actions()
-    _, _, traj = _run(name, acts)
+def test_restore_and_replay_is_bitwise_exact(fetch, name):
+    T = fetch.T
+    _, _, traj = _episodes(fetch, name, "random")
+    acts = fetch.random_actions(1)
     saved = _at(traj, K - 1)  # the state after K steps
     replay = jnp.concatenate([acts[K:], acts[:K]])  # same length: same compiled program
-    _, _, again = _run(name, replay, state=saved)
+    _, _, again = fetch.run(_env(name), replay, state=saved)
     first, second = _at(traj, slice(K, T)), _at(again, slice(0, T - K))
     jax.tree_util.tree_map(np.testing.assert_array_equal, first, second)
     assert not bool(traj.invalid.any())
@@ -333,10 +324,10 @@ def test_restore_and_replay_is_bitwise_exact(name):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["push", "pick_and_place"])
-def test_actions_are_clipped_and_observation_is_consistent(name):
-    acts = _random_actions(2) * 5.0
-    _, _, clipped = _run(name, jnp.clip(acts, -1.0, 1.0))
-    _, _, big = _run(name, acts)
+def test_actions_are_clipped_and_observation_is_consistent(fetch, name):
+    acts = fetch.random_actions(2) * 5.0
+    _, _, clipped = fetch.run(_env(name), jnp.clip(acts, -1.0, 1.0))
+    _, _, big = fetch.run(_env(name), acts)
     np.testing.assert_array_equal(clipped.obs, big.obs)
     # The gripper did move: random actions shift it from home.
     obs = np.asarray(big.obs)
@@ -348,10 +339,10 @@ def test_actions_are_clipped_and_observation_is_consistent(name):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["reach", "push"])
-def test_nan_action_is_flagged(name):
-    acts = np.asarray(_random_actions(3)).copy()
+def test_nan_action_is_flagged(fetch, name):
+    acts = np.asarray(fetch.random_actions(3)).copy()
     acts[3, 1, 0] = np.nan
-    _, _, traj = _run(name, acts)
+    _, _, traj = fetch.run(_env(name), acts)
     invalid = np.asarray(traj.invalid)
     assert not invalid[:, 0].any()  # the other episode is untouched
     assert not invalid[:3, 1].any() and invalid[3:, 1].all()  # flagged from the bad step on, and stays
@@ -359,16 +350,17 @@ def test_nan_action_is_flagged(name):
 
 @pytest.mark.slow
 @pytest.mark.parametrize(("name", "need"), [("reach", 1.0), ("push", 0.75), ("pick_and_place", 0.75), ("slide", 0.75)])
-def test_scripted_controllers_succeed_in_most_episodes(name, need):
-    _, final, traj = _run(name, np.zeros((T, B, 4)), w=1.0)
+def test_scripted_controllers_succeed_in_most_episodes(fetch, name, need):
+    _, _, traj = _episodes(fetch, name, "scripted")
     reached = np.asarray(traj.success).any(axis=0)
     assert reached.mean() >= need, reached
     assert not bool(traj.invalid.any())
 
 
-def test_slide_gripper_driven_away_stops_on_the_arm_reach():
-    acts = np.broadcast_to(np.array([1.0, 0.2, -1.0, 0.0]), (T, B, 4))
-    _, _, traj = _run("slide", acts)
+@pytest.mark.slow
+def test_slide_gripper_driven_away_stops_on_the_arm_reach(fetch):
+    acts = np.broadcast_to(np.array([1.0, 0.2, -1.0, 0.0]), (fetch.T, fetch.B, 4))
+    _, _, traj = fetch.run(_env("slide"), acts)
     grip = np.asarray(traj.obs)[-1, :, 0:3]
     dist = np.linalg.norm(grip - np.asarray(models.ARM_REACH_CENTER["slide"]), axis=1)
     np.testing.assert_allclose(dist, models.ARM_REACH_RADIUS, atol=0.01)
@@ -376,28 +368,24 @@ def test_slide_gripper_driven_away_stops_on_the_arm_reach():
 
 
 @pytest.mark.slow
-def test_weld_drive_in_mjx_follows_the_target_like_the_pd_drive():
+def test_weld_drive_in_mjx_follows_the_target_like_the_pd_drive(fetch):
     """The reference's weld law (a constraint to a mocap body that ``simulate`` puts at the target) moves
     the gripper along the same path as the PD drive does, to within 3 mm; a restored state replays
     bit for bit under it too (the mocap body follows the saved control)."""
-    acts = jnp.asarray(np.broadcast_to(np.array([1.0, -0.5, 0.5, 0.0], np.float32), (6, 4)))
-    paths = []
-    for drive in ("pd", "weld"):
-        env = envs.make("reach", drive=drive)
-        run = jax.jit(lambda s, a, env=env: jax.lax.scan(lambda s, a: (env.step(s, a),) * 2, s, a)[1])
-        traj = run(env.reset(jax.random.PRNGKey(0)), acts)
-        paths.append(np.asarray(traj.obs)[:, 0:3])
-    replay = run(jax.tree.map(lambda x: x[2], traj), acts)  # from the state after step 3: steps 4 to 6
-    np.testing.assert_array_equal(np.asarray(replay.obs)[:3], np.asarray(traj.obs)[3:])
-    pd, weld = paths
-    steps = np.linalg.norm(np.diff(pd, axis=0), axis=1)
+    acts = np.broadcast_to(np.array([1.0, -0.5, 0.5, 0.0], np.float32), (fetch.T, fetch.B, 4))
+    weld = envs.make("reach", drive="weld")
+    _, _, traj = fetch.run(weld, acts)
+    replay = fetch.run(weld, acts, state=_at(traj, 2))[2]  # from the state after step 3: steps 4 on
+    jax.tree_util.tree_map(np.testing.assert_array_equal, _at(replay, slice(0, fetch.T - 3)), _at(traj, slice(3, None)))
+    pd = np.asarray(fetch.run(_env("reach"), acts)[2].obs)[:6, :, 0:3]
+    steps = np.linalg.norm(np.diff(pd, axis=0), axis=-1)
     assert steps.min() > 0.025  # both move 3 to 5 cm per step at full action
-    np.testing.assert_allclose(weld, pd, atol=0.003)
+    np.testing.assert_allclose(np.asarray(traj.obs)[:6, :, 0:3], pd, atol=0.003)
 
 
 @pytest.mark.slow
-def test_struck_slide_puck_stays_flat_on_the_table():
-    s0, _, traj = _run("slide", np.zeros((T, B, 4)), w=1.0)  # the scripted slide's program and episodes
+def test_struck_slide_puck_stays_flat_on_the_table(fetch):
+    s0, _, traj = _episodes(fetch, "slide", "scripted")
     obs = np.asarray(traj.obs)
     assert np.abs(obs[..., 3:6] - np.asarray(s0.obs)[None, :, 3:6]).max() > 0.1  # the pucks were struck
     assert np.abs(obs[..., 11:13]).max() < 0.05  # roll and pitch: no tipping

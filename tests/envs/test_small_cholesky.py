@@ -53,18 +53,14 @@ def test_substitution_holds_only_inside_the_block():
     assert (jsl.cho_factor, jsl.cho_solve) == library
 
 
-def test_push_step_has_no_library_cholesky_and_steps_alike(primitives):
+@pytest.mark.slow
+def test_push_step_has_no_library_cholesky_and_steps_alike(fetch, primitives):
     fast, library = envs.make("push"), envs.make("push", cholesky="library")
-    state = jax.vmap(fast.reset)(jax.random.split(jax.random.PRNGKey(0), 2))
-    action = jnp.array([[0.5, -0.3, -1.0, 0.0], [-1.0, 1.0, 0.2, 0.0]])
-    prims_fast = primitives(jax.vmap(fast.step), state, action)
-    prims_lib = primitives(jax.vmap(library.step), state, action)
+    state, actions, w = fetch.reset(fast), fetch.random_actions(1), jnp.zeros(fetch.B)
+    prims_fast = primitives(fetch.program(fast), state, actions, w)  # the traces the runs then compile
+    prims_lib = primitives(fetch.program(library), state, actions, w)
     assert "cholesky" in prims_lib and "cholesky" not in prims_fast
     assert "triangular_solve" not in prims_fast
-
-    def run(env):
-        return jax.jit(lambda s: jax.lax.fori_loop(0, 3, lambda _, x: jax.vmap(env.step)(x, action), s))(state)
-
-    a, b = run(fast), run(library)
-    np.testing.assert_allclose(a.physics.qpos, b.physics.qpos, atol=1e-4)
+    a, b = (jax.tree_util.tree_map(lambda x: x[2], fetch.run(env, actions)[2]) for env in (fast, library))
+    np.testing.assert_allclose(a.physics.qpos, b.physics.qpos, atol=1e-4)  # after 3 steps
     np.testing.assert_allclose(a.physics.qvel, b.physics.qvel, atol=1e-2)

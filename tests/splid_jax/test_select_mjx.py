@@ -1,15 +1,20 @@
-"""SELECT's work queue on an MJX task (Push): the lanes' verdicts equal each candidate replayed alone."""
+"""SELECT's work queue on an MJX task (Push): the lanes' verdicts equal each candidate replayed alone.
+
+The explored episodes and the lone replays both run in Push's shared episode program (conftest), so
+the only program compiled here is SELECT's own."""
 
 import jax
 import jax.numpy as jnp
 import numpy as np
+import pytest
 
 import envs
 from envs.fetch import scripted
 from splid_jax.explore import Trajectory
-from splid_jax.select import policy_reaches, select
+from splid_jax.select import select
 
-T, H, N = 20, 4, 3
+H = 4
+MOVING = 3  # envs where the noisy scripted pusher explores; the others rest and give no candidate
 
 
 class ScriptedPolicy:
@@ -19,41 +24,38 @@ class ScriptedPolicy:
         return scripted.push(obs, goal)
 
 
-def test_push_queue_verdicts_match_single_replays():
-    env = envs.make("push", max_episode_steps=T)
-    policy = ScriptedPolicy()
+def explored(fetch, env) -> Trajectory:
+    moving = np.arange(fetch.B) < MOVING
+    noise = 0.3 * jax.random.normal(jax.random.PRNGKey(0), (fetch.T, fetch.B, 4)) * moving[:, None]
+    s0, _, after = fetch.run(env, noise, w=moving)
+    states = jax.tree_util.tree_map(lambda first, rest: jnp.concatenate([first[None], rest[:-1]]), s0, after)
+    actions = jnp.clip(noise + moving[:, None] * scripted.push(states.obs, states.desired_goal), -1.0, 1.0)
+    return Trajectory(
+        states,
+        actions,
+        jnp.concatenate([s0.achieved_goal[None], after.achieved_goal]),
+        jnp.concatenate([s0.invalid[None], after.invalid]),
+    )
 
-    def roll(key):
-        k0, k1 = jax.random.split(key)
-        s0 = jax.vmap(env.reset)(jax.random.split(k0, N))
 
-        def one(s, k):
-            a = jnp.clip(scripted.push(s.obs, s.desired_goal) + 0.3 * jax.random.normal(k, (N, 4)), -1, 1)
-            nxt = jax.vmap(env.step)(s, a)
-            return nxt, (s, a, nxt.achieved_goal, nxt.invalid)
-
-        _, (states, acts, ag, inv) = jax.lax.scan(one, s0, jax.random.split(k1, T))
-        return Trajectory(
-            states, acts, jnp.concatenate([s0.achieved_goal[None], ag]), jnp.concatenate([s0.invalid[None], inv])
-        )
-
-    traj = jax.jit(roll)(jax.random.PRNGKey(0))
+@pytest.mark.slow
+def test_push_queue_verdicts_match_single_replays(fetch):
+    env, policy, n = envs.make("push"), ScriptedPolicy(), fetch.T * fetch.B
+    traj = explored(fetch, env)
     cands = jax.jit(lambda tr: select(env, policy, None, tr, H, jnp.int32(H), True, 0.1))(traj)
-    starts = jax.tree_util.tree_map(lambda x: x.reshape((T * N,) + x.shape[2:]), traj.states)
     valid = np.asarray(cands.valid)
     idx = np.flatnonzero(valid)
-    alone = jax.jit(
-        jax.vmap(
-            lambda i: policy_reaches(
-                env,
-                policy,
-                None,
-                jax.tree_util.tree_map(lambda x: x[i % (T * N)], starts),
-                cands.goal[i],
-                i // (T * N) + 1,
-            )
-        )
-    )(jnp.asarray(idx))
+    # each valid candidate alone: the scripted pusher restored at its start state, pursuing its goal,
+    # hits it within its h steps (policy_reaches' definition), B candidates per run of the program
+    starts = jax.tree_util.tree_map(lambda x: x.reshape((n,) + x.shape[2:]), traj.states)
+    with_goal = jax.jit(jax.vmap(env.with_goal))
+    zeros, alone = np.zeros((fetch.T, fetch.B, 4)), []
+    for lo in range(0, len(idx), fetch.B):
+        c = np.resize(idx[lo : lo + fetch.B], fetch.B)  # the last batch repeats its candidates
+        start = with_goal(jax.tree_util.tree_map(lambda x, c=c: x[c % n], starts), cands.goal[c])
+        run = fetch.run(env, zeros, w=1.0, state=start)[2]
+        hit = np.asarray(run.success & ~run.invalid)  # [T, B]
+        alone += [hit[: c[j] // n + 1, j].any() for j in range(min(fetch.B, len(idx) - lo))]
     alone = np.asarray(alone)
     assert len(idx) > 0 and 0 < alone.sum() < len(idx)
     np.testing.assert_array_equal(np.asarray(cands.accept)[idx], ~alone)

@@ -1,0 +1,101 @@
+"""Shared by every test: a compile cache of the run's own, and the compiled programs tests share.
+
+Compiling one MJX program takes 10-30 s on a 2-core CPU, so each Fetch task's episodes come from one
+program (``FetchEpisodes``) that every test stepping that task reuses, at one batch size and length.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import shutil
+import tempfile
+
+import jax
+import jax.extend.core
+import jax.numpy as jnp
+import pytest
+
+_CACHE_HOME = tempfile.mkdtemp(prefix="splid-jax-tests-")
+
+
+def pytest_configure(config):
+    # Before the first compilation: the run neither reads nor writes the user's ~/.cache (JAX's
+    # programs, the CLI's default --compile-cache, subprocesses' caches), and starts cold every time.
+    os.environ["XDG_CACHE_HOME"] = _CACHE_HOME
+    from splid_jax.cli import default_compile_cache
+
+    os.environ["JAX_COMPILATION_CACHE_DIR"] = default_compile_cache()
+    jax.config.update("jax_compilation_cache_dir", default_compile_cache())
+
+
+def pytest_unconfigure(config):
+    shutil.rmtree(_CACHE_HOME, ignore_errors=True)
+
+
+def _primitives(jaxpr) -> set[str]:
+    names = set()
+    for eqn in jaxpr.eqns:
+        names.add(eqn.primitive.name)
+        for sub in jax.extend.core.jaxprs_in_params(eqn.params):
+            names |= _primitives(sub)
+    return names
+
+
+@pytest.fixture(scope="session")
+def primitives():
+    """``primitives(fn, *args)``: the names of the primitives in ``fn``'s jaxpr at ``args``, nested
+    jaxprs included."""
+    return lambda fn, *args: _primitives(jax.make_jaxpr(fn)(*args).jaxpr)
+
+
+B, T = 8, 50  # envs and steps of every Fetch run (one episode)
+
+
+@functools.cache
+def _program(env):
+    from envs.fetch import scripted
+
+    ctl = scripted.CONTROLLERS[env.kind]
+
+    @jax.jit
+    def run(state, actions, w):
+        def body(s, a):
+            s = jax.vmap(env.step)(s, a + w[:, None] * ctl(s.obs, s.desired_goal))
+            return s, s
+
+        return jax.lax.scan(body, state, actions)
+
+    return run
+
+
+@functools.cache
+def _reset(env):
+    return jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, B)))
+
+
+class FetchEpisodes:
+    """One compiled episode program per Fetch task (any ``envs.make`` variant), always at batch ``B``
+    and length ``T``: a scan of the batched step whose action is ``actions[t] + w * scripted(obs, goal)``.
+    """
+
+    B, T = B, T
+    program = staticmethod(_program)
+
+    def reset(self, env, seed=0):
+        return _reset(env)(jax.random.PRNGKey(seed))
+
+    def random_actions(self, seed=1):
+        return jax.random.uniform(jax.random.PRNGKey(seed), (self.T, self.B, 4), minval=-1.0, maxval=1.0)
+
+    def run(self, env, actions, w=0.0, state=None):
+        """(start, final, trajectory): ``trajectory[t]`` is the state after step t + 1; ``w`` is one weight
+        or one per env."""
+        s0 = self.reset(env) if state is None else state
+        w = jnp.broadcast_to(jnp.asarray(w, jnp.float32), (self.B,))
+        return s0, *self.program(env)(s0, jnp.asarray(actions, jnp.float32), w)
+
+
+@pytest.fixture(scope="session")
+def fetch():
+    return FetchEpisodes()
