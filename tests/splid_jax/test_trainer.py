@@ -9,6 +9,8 @@ import envs
 from splid_jax.config import TrainConfig
 from splid_jax.trainer import Trainer
 
+pytestmark = pytest.mark.slow  # trains
+
 CFG = dict(env="point", num_envs=16, iterations=40, eval_every=10, bc_steps=50, batch_size=128, eval_episodes=256)
 
 
