@@ -1,0 +1,588 @@
+"""``python -m splid_jax.figures FIG --env ENV``: the paper's figures, each from one command.
+
+Every series is trained through the one host loop (``splid_jax.loop``) as one vmapped sweep whose
+members are the seeds (and, for Figures 4 and 5, the values of H or sigma), in OUT/METHOD/. Every
+method gets the same budget of exploration episodes: its iterations are the budget over its
+episodes per iteration, rounded to whole compiled chunks, and the CSV says what each one ran. The
+figure and its CSV are drawn from the run directories alone, so ``--replot`` redraws them without
+training; OUT/figure.json records the command, the device and the date."""
+
+from __future__ import annotations
+
+from splid_jax.cli import quiet_interrupts
+
+if __name__ == "__main__":  # a signal while JAX loads ends the process with one line, no traceback
+    quiet_interrupts()
+
+import argparse  # noqa: E402
+import csv  # noqa: E402
+import dataclasses  # noqa: E402
+import datetime  # noqa: E402
+import json  # noqa: E402
+import math  # noqa: E402
+import os  # noqa: E402
+import shlex  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from collections.abc import Sequence  # noqa: E402
+from typing import Any  # noqa: E402
+
+import matplotlib  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.ticker import EngFormatter  # noqa: E402
+
+import envs  # noqa: E402
+from envs.base import InvalidConfig, check  # noqa: E402
+from splid_jax import checkpoint, loop, plot, progress  # noqa: E402
+from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache  # noqa: E402
+from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
+
+SPEC = "figure.json"  # the figure's command, device, date and what each method ran
+
+
+@dataclasses.dataclass(frozen=True)
+class Method:
+    label: str
+    fields: dict[str, Any]  # the TrainConfig fields that make the method
+
+
+METHODS: dict[str, Method] = {
+    "splid": Method("SPLID", {"algo": "splid", "select": True}),
+    "gcsl": Method("GCSL", {"algo": "gcsl"}),
+    "pchid": Method("PCHID", {"algo": "pchid"}),
+    "her": Method("HER (DDPG + HER)", {"algo": "her"}),
+    "es": Method("ES (OpenAI-ES)", {"algo": "es"}),
+    "no-select": Method("SPLID without SELECT", {"algo": "splid", "select": False}),
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class Spec:
+    """What one figure trains and draws."""
+
+    title: str
+    methods: tuple[str, ...]  # the methods it trains, in legend order
+    panels: tuple[tuple[str, str], ...]  # (metric, panel title)
+    vary: str | None = None  # a config field whose values a sweep spans, one series each
+    values: tuple = ()  # its values by default
+
+
+SUCCESS = (("eval_success", "success at any step"), ("eval_success_final", "success at the final step"))
+SPECS: dict[str, Spec] = {
+    "fig3": Spec("SPLID against its baselines", tuple(METHODS), SUCCESS),
+    "fig4": Spec("SPLID's learning horizon H", ("splid",), SUCCESS, "horizon", (1, 2, 4, 8, 16)),
+    "fig5": Spec("SPLID's exploration factor sigma", ("splid",), SUCCESS, "sigma", (0.25, 0.5, 1.0, 2.0)),
+    "fig6": Spec("SPLID with and without SELECT", ("splid", "no-select"), (("eval_return", "average return"),)),
+}
+SHORT = {"horizon": "H", "sigma": "sigma"}  # a swept field's name in member names and labels
+
+# Exploration episodes per method by default (the paper's x axes); other tasks: their default run's.
+BUDGETS = {"push": 20_000, "slide": 100_000, "pick_and_place": 100_000}
+# Set by the figure itself, not through --set.
+OWNED = frozenset({"env", "algo", "select", "seed", "iterations", "run_dir"})
+
+# --quick: the point task, sizes that train six methods on a 2-core CPU in a few minutes.
+QUICK_EPISODES = 320
+QUICK_FIELDS: dict[str, Any] = dict(
+    num_envs=16, eval_every=5, eval_episodes=50, bc_steps=20, batch_size=64, hidden=(32, 32), buffer_size=20_000
+)
+QUICK_METHOD_FIELDS: dict[str, dict[str, Any]] = {}
+
+
+def default_budget(env: str) -> int:
+    """The task's budget: the paper's for the Fetch tasks, the default run's (iterations x envs) otherwise."""
+    if env in BUDGETS:
+        return BUDGETS[env]
+    return TASK_DEFAULTS[env]["iterations"] * TASK_DEFAULTS[env]["num_envs"]
+
+
+def parse_methods(text: str, allowed: Sequence[str]) -> tuple[str, ...]:
+    words = tuple(w.strip() for w in text.split(","))
+    bad = [w for w in words if w not in allowed]
+    check(
+        not bad and len(set(words)) == len(words) and words != ("",),
+        "methods",
+        text,
+        "distinct names among " + ", ".join(allowed),
+    )
+    return words
+
+
+def _convert(name: str, text: str, kind: str):
+    """A --set value as the field's type."""
+    try:
+        if kind == "bool":
+            check(text.lower() in ("true", "false", "1", "0"), name, text, "true or false")
+            return text.lower() in ("true", "1")
+        if kind == "tuple[int, ...]":
+            return tuple(int(w) for w in text.split(","))
+        if kind == "int":
+            return int(text)
+        if kind == "float":
+            return float(text)
+    except ValueError:
+        raise InvalidConfig(name, text, f"a value of type {kind}") from None
+    return text
+
+
+def parse_sets(items: Sequence[str], methods: Sequence[str]) -> dict[str | None, dict[str, Any]]:
+    """``[METHOD.]FIELD=VALUE`` items as {None: fields for every method, METHOD: its own fields}."""
+    types = {f.name: f.type for f in dataclasses.fields(TrainConfig)}
+    out: dict[str | None, dict[str, Any]] = {None: {}}
+    for item in items:
+        key, eq, value = item.partition("=")
+        method, dot, name = key.rpartition(".")
+        name = name.replace("-", "_")
+        if not eq or (dot and method not in methods):
+            allowed = "[METHOD.]FIELD=VALUE with METHOD among " + ", ".join(methods)
+            raise InvalidConfig("set", item, allowed)
+        check(
+            name in types and name not in OWNED,
+            "set",
+            item,
+            "a TrainConfig field other than " + ", ".join(sorted(OWNED)) + " (see python -m splid_jax.train --help)",
+        )
+        out.setdefault(method or None, {})[name] = _convert(name, value, types[name])
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# What to train
+
+
+@dataclasses.dataclass(frozen=True)
+class Plan:
+    """One method's vmapped sweep."""
+
+    method: str
+    base: TrainConfig
+    lanes: tuple[TrainConfig, ...]
+    episodes_per_iteration: int
+
+
+def member_name(seed: int, vary: str | None, value) -> str:
+    return f"s{seed}" if vary is None else f"{SHORT[vary]}{value:g}-s{seed}"
+
+
+def plan(
+    spec: Spec,
+    env_name: str,
+    methods: Sequence[str],
+    seeds: int,
+    budget: int,
+    sets: dict[str | None, dict[str, Any]],
+    out: str,
+    values: Sequence = (),
+    quick: bool = False,
+) -> list[Plan]:
+    """Each method's sweep: its config, its members and its iterations for ``budget`` episodes.
+    Builds every method's learner, so a setting none accepts fails here, before any training."""
+    check(seeds >= 1, "seeds", seeds, "an integer >= 1")
+    check(budget >= 1, "episodes", budget, "an integer >= 1")
+    values = tuple(values) or spec.values
+    made: dict[str, envs.GoalEnv] = {}
+    plans = []
+    for name in methods:
+        fields = {
+            "env": env_name,
+            **(QUICK_FIELDS if quick else {}),
+            **(QUICK_METHOD_FIELDS.get(name, {}) if quick else {}),
+        }
+        fields.update(sets.get(None, {}), **sets.get(name, {}), **METHODS[name].fields)
+        if spec.vary:
+            fields[spec.vary] = max(values)  # shapes for the largest H, as a sweep's
+        every = fields.get("eval_every", TASK_DEFAULTS[env_name]["eval_every"])
+        probe = TrainConfig(**fields, iterations=every, run_dir=os.path.join(out, name))
+        options = probe.env_options
+        if options not in made:
+            made[options] = loop.make_env(env_name, **probe.env_overrides())
+        env = made[options]
+        probe.check_env(env)
+        per_iteration = loop.make_algorithm(probe, env).counters(1, 0)["episodes"]
+        chunks = max(1, round(budget / (per_iteration * probe.eval_every)))
+        base = dataclasses.replace(probe, iterations=chunks * probe.eval_every)
+        grid = [(s, v) for v in (values if spec.vary else (None,)) for s in range(seeds)]
+        lanes = tuple(
+            dataclasses.replace(
+                base,
+                seed=s,
+                run_dir=os.path.join(base.run_dir, member_name(s, spec.vary, v)),
+                **({spec.vary: v} if spec.vary else {}),
+            )
+            for s, v in grid
+        )
+        for lane in lanes:
+            lane.check_env(env)
+        loop.make_algorithm(base, env)  # the run's own settings (PCHID's schedule follows the iterations)
+        plans.append(Plan(name, base, lanes, per_iteration))
+    return plans
+
+
+def device_name() -> str:
+    import jax
+
+    device = jax.devices()[0]
+    if device.platform == "cpu":
+        return f"CPU ({os.cpu_count()} cores)"
+    return device.device_kind
+
+
+def check_out(out: str) -> None:
+    if os.path.isdir(out) and os.listdir(out):
+        raise InvalidConfig("out", out, "a new or empty directory (--replot redraws the figure in it)")
+    check(not os.path.exists(out) or os.path.isdir(out), "out", out, "a directory, not a file")
+    loop.check_writable(out)
+
+
+def describe(plans: Sequence[Plan]) -> dict:
+    """What each method runs, as OUT/figure.json keeps it: enough to resume or redraw the figure."""
+    return {
+        p.method: {
+            "iterations": p.base.iterations,
+            "episodes_per_iteration": p.episodes_per_iteration,
+            "episodes": p.base.iterations * p.episodes_per_iteration,
+            "config": {**p.base.to_json(), "run_dir": None},
+            "members": [{**m.to_json(), "run_dir": os.path.basename(m.run_dir)} for m in p.lanes],
+        }
+        for p in plans
+    }
+
+
+def train(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
+    """Trains each method's sweep in turn (on ``resume``, those with a checkpoint from it), noting in
+    OUT/figure.json the seconds each took."""
+    _write_json(os.path.join(out, SPEC), record)
+    for method in record["methods"]:
+        ran, run_dir = record["runs"][method], os.path.join(out, method)
+        base = TrainConfig(**{**ran["config"], "run_dir": run_dir})
+        lanes = [TrainConfig(**{**m, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in ran["members"]]
+        again = resume and os.path.isdir(run_dir) and checkpoint.latest_step(run_dir) is not None
+        progress.show(
+            f"{record['figure']} {method}: {len(lanes)} members, {base.iterations} iterations x "
+            f"{ran['episodes_per_iteration']} episodes = {ran['episodes']:,} episodes "
+            f"(budget {record['budget_episodes']:,})" + (", resumed" if again else ""),
+            quiet,
+        )
+        t0 = time.perf_counter()
+        env = loop.make_env(base.env, **base.env_overrides())
+        loop.run(base, env, members=lanes, resume=again, quiet=quiet)
+        ran["total_s"] = round(ran.get("total_s", 0.0) + time.perf_counter() - t0, 1)  # compilation included
+        _write_json(os.path.join(out, SPEC), record)
+
+
+def _write_json(path: str, obj) -> None:
+    tmp = path + ".tmp"
+    with open(tmp, "w") as fh:
+        json.dump(obj, fh, indent=2)
+    os.replace(tmp, path)
+
+
+# ---------------------------------------------------------------------------------------------
+# From the run directories to a figure
+
+
+@dataclasses.dataclass(frozen=True)
+class Series:
+    method: str
+    value: Any  # the swept field's value, or None
+    label: str
+    seeds: int
+    columns: dict[str, np.ndarray]  # iteration, episodes, wall_s: per evaluation
+    mean: dict[str, np.ndarray]
+    sem: dict[str, np.ndarray]  # standard error of the mean over seeds (nan for one seed)
+
+
+MEASURES = ("eval_success", "eval_success_final", "eval_return")
+
+
+def load_record(out: str) -> dict:
+    path = os.path.join(out, SPEC)
+    try:
+        with open(path) as fh:
+            record = json.load(fh)
+        check(record.get("figure") in SPECS, "replot", out, f"a figure directory ({path} names no figure)")
+        return record
+    except (OSError, json.JSONDecodeError):
+        raise InvalidConfig("replot", out, f"a directory holding the {SPEC} a figure command wrote") from None
+
+
+def load_series(out: str, record: dict) -> list[Series]:
+    """Each method's members from OUT/METHOD/, grouped by the swept value, over the evaluations
+    every member of the group reached."""
+    spec = SPECS[record["figure"]]
+    series = []
+    for method in record["methods"]:
+        runs = []
+        for member in record["runs"][method]["members"]:
+            try:
+                runs.append(plot.load_run(os.path.join(out, method, member["run_dir"])))
+            except plot.PlotError:
+                continue  # not trained yet, or stopped before its first evaluation
+        groups: dict[Any, list[plot.Run]] = {}
+        for run in runs:
+            groups.setdefault(run.config.get(spec.vary) if spec.vary else None, []).append(run)
+        for value, members in sorted(groups.items(), key=lambda kv: (kv[0] is None, kv[0])):
+            common = sorted(set.intersection(*(set(r.columns["iteration"].tolist()) for r in members)))
+            if not common:
+                continue
+            at = [np.searchsorted(r.columns["iteration"], common) for r in members]
+            stacked = {
+                k: np.stack([r.columns[k][i] for r, i in zip(members, at, strict=True)])
+                for k in (*MEASURES, "episodes", "wall_s")
+            }
+            n = len(members)
+            sem = {
+                k: stacked[k].std(0, ddof=1) / math.sqrt(n) if n > 1 else np.full(len(common), np.nan) for k in MEASURES
+            }
+            label = METHODS[method].label if not spec.vary else f"{SHORT[spec.vary]} = {value:g}"
+            if members[0].config.get("algo") == "gcsl":
+                label += f" ({members[0].config.get('gcsl_relabel')}-state relabelling)"
+            columns = {
+                "iteration": np.asarray(common),
+                "episodes": stacked["episodes"][0],
+                "wall_s": stacked["wall_s"].mean(0),
+            }
+            series.append(Series(method, value, label, n, columns, {k: stacked[k].mean(0) for k in MEASURES}, sem))
+    return series
+
+
+def write_csv(path: str, series: Sequence[Series], record: dict) -> None:
+    """One row per series and evaluation; the run columns say what each method ran in all."""
+    spec = SPECS[record["figure"]]
+    head = ["method", *([spec.vary] if spec.vary else []), "iteration", "episodes"]
+    head += [f"{m}_{s}" for m in MEASURES for s in ("mean", "sem")]
+    head += ["seeds", "wall_s", "episodes_per_iteration", "run_iterations", "run_episodes", "budget_episodes"]
+    with open(path, "w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(head)
+        for s in series:
+            ran = record["runs"][s.method]
+            for i in range(len(s.columns["iteration"])):
+                row: list[Any] = [s.method, *([s.value] if spec.vary else [])]
+                row += [int(s.columns["iteration"][i]), int(s.columns["episodes"][i])]
+                for m in MEASURES:
+                    row += [f"{s.mean[m][i]:.6g}", "" if math.isnan(s.sem[m][i]) else f"{s.sem[m][i]:.6g}"]
+                row += [
+                    s.seeds,
+                    f"{s.columns['wall_s'][i]:.1f}",
+                    ran["episodes_per_iteration"],
+                    ran["iterations"],
+                    ran["episodes"],
+                    record["budget_episodes"],
+                ]
+                writer.writerow(row)
+
+
+def title(record: dict, series: Sequence[Series]) -> str:
+    spec = SPECS[record["figure"]]
+    seeds = sorted({s.seeds for s in series})
+    per = "setting" if spec.vary else "method"
+    n = "-".join(str(k) for k in (seeds[0], seeds[-1]) if k) if len(seeds) > 1 else str(seeds[0])
+    return (
+        f"Figure {record['figure'][3:]}: {spec.title} on {record['env']}, {record['budget_episodes']:,} exploration "
+        f"episodes per {per}\n{n} seeds per {per}, mean and standard error; {record['device']}, {record['date']}"
+    )
+
+
+def draw(record: dict, series: Sequence[Series]) -> Figure:
+    spec = SPECS[record["figure"]]
+    fig = Figure(figsize=(6.5 * len(spec.panels), 5.2), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(1, len(spec.panels), sharey=True))
+    cmap = matplotlib.colormaps["tab10"]
+    for i, s in enumerate(series):
+        x = s.columns["episodes"]
+        one = len(x) == 1  # a single evaluation is a point: a line through it alone draws nothing
+        for ax, (metric, _) in zip(axes, spec.panels, strict=True):
+            ax.plot(
+                x,
+                s.mean[metric],
+                color=cmap(i % 10),
+                lw=1.8,
+                marker="o" if one else None,
+                label=f"{s.label} ({s.seeds} seed{'s' * (s.seeds > 1)})",
+            )
+            if not np.isnan(s.sem[metric]).all():
+                lo, hi = s.mean[metric] - s.sem[metric], s.mean[metric] + s.sem[metric]
+                ax.fill_between(x, lo, hi, color=cmap(i % 10), alpha=0.2, lw=0)
+    for ax, (metric, name) in zip(axes, spec.panels, strict=True):
+        ax.set_title(name)
+        ax.set_xlabel("exploration episodes")
+        ax.xaxis.set_major_formatter(EngFormatter(sep=""))
+        ax.grid(alpha=0.3)
+        if metric != "eval_return":
+            ax.set_ylim(-0.02, 1.02)
+    axes[0].set_ylabel("average return" if spec.panels[0][0] == "eval_return" else "evaluation success rate")
+    handles, names = axes[0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, names, loc="outside lower center", ncols=min(len(names), 3), fontsize="small")
+    fig.suptitle(title(record, series))
+    return fig
+
+
+def render(out: str, quiet: bool = False) -> tuple[str, str]:
+    """The figure and its CSV from the run directories under ``out``; returns their paths."""
+    record = load_record(out)
+    series = load_series(out, record)
+    check(bool(series), "out", out, "a figure directory with at least one evaluation in its runs")
+    stem = os.path.join(out, f"{record['figure']}-{record['env']}")
+    write_csv(stem + ".csv", series, record)
+    draw(record, series).savefig(stem + ".png", dpi=120)
+    missing = [m for m in record["methods"] if m not in {s.method for s in series}]
+    if missing:
+        progress.show(f"not drawn (no evaluation yet): {', '.join(missing)}", quiet)
+    return stem + ".png", stem + ".csv"
+
+
+# ---------------------------------------------------------------------------------------------
+# Command line
+
+HELP = """\
+fig3: SPLID, GCSL, PCHID, HER, ES and SPLID without SELECT, success at any step and at the final step
+      (GCSL pairs each step with the episode's last state, as the paper describes it: --set gcsl.gcsl_relabel=future
+      for the original's future states).
+fig4: SPLID with H in 1, 2, 4, 8, 16 (one sweep).
+fig5: SPLID with sigma in 0.25, 0.5, 1, 2 (one sweep).
+fig6: average return of SPLID with and without SELECT.
+Figures 8 and 9 (SPLID and GCSL on Point2D-FourRooms, Reacher and SawyerDoor) are not offered yet: the
+Reacher and SawyerDoor tasks do not exist.
+
+Each method is one vmapped sweep over its seeds in OUT/METHOD/ (run directories as splid_jax.sweep
+writes them); OUT/figure.json records the command, device, date and what each method ran; the PNG and
+CSV (method, episodes, mean and standard error of each measure, seeds, wall-clock seconds of training
+without compilation, iterations and episodes each method ran) lie in OUT.
+Exit codes: 0 done, 2 bad input (nothing trained), 3 a run stopped (NaN), 130 Ctrl-C, 143 SIGTERM
+(each method's newest state is kept; --resume continues)."""
+
+
+def build_parser() -> Parser:
+    parser = Parser(
+        prog="python -m splid_jax.figures",
+        description="The paper's figures from one command each: every method trained with the same budget of "
+        "exploration episodes through the one host loop, several seeds as one vmapped program, mean and standard "
+        "error against episodes, a PNG and a CSV.",
+        epilog=HELP,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("figure", choices=sorted(SPECS), help="which figure")
+    parser.add_argument(
+        "--env", default=None, help="task: " + ", ".join(envs.names()) + " (default push; --quick: point)"
+    )
+    parser.add_argument(
+        "--methods", default=None, help="fig3: a comma-separated subset of " + ", ".join(METHODS) + " (default: all)"
+    )
+    parser.add_argument("--seeds", type=int, default=5, help="seeds per method or setting (default: 5)")
+    parser.add_argument(
+        "--episodes",
+        type=int,
+        default=None,
+        metavar="N",
+        help="exploration episodes per method (default: push 20,000, slide and pick_and_place "
+        "100,000, other tasks their default run's; --quick: 320); each method's iterations are "
+        "N / its episodes per iteration, rounded to whole chunks of eval_every iterations",
+    )
+    parser.add_argument(
+        "--values", default=None, help="fig4: H values (default 1,2,4,8,16); fig5: sigma values (default 0.25,0.5,1,2)"
+    )
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="[METHOD.]FIELD=VALUE",
+        help="a training setting (a TrainConfig field, as python -m splid_jax.train --help lists "
+        "them) for every method, or with METHOD. for one; repeatable",
+    )
+    parser.add_argument(
+        "--quick",
+        action="store_true",
+        help="the point task with a tiny budget and small networks: the same code in a few minutes "
+        "on a CPU (out: runs/DATE/FIG-point-quick)",
+    )
+    parser.add_argument(
+        "--out", default=None, metavar="DIR", help="a new or empty directory (default experiments/results/DATE/FIG-ENV)"
+    )
+    parser.add_argument("--replot", action="store_true", help="redraw the figure and CSV in --out from its runs")
+    parser.add_argument("--resume", action="store_true", help="continue the figure in --out where its runs stopped")
+    parser.add_argument("--quiet", action="store_true", help="no progress display")
+    add_compile_cache_flag(parser)
+    return parser
+
+
+def _values(spec: Spec, text: str | None) -> tuple:
+    if text is None:
+        return ()
+    check(spec.vary is not None, "values", text, "given only for fig4 (H) or fig5 (sigma)")
+    kind = int if spec.vary == "horizon" else float
+    try:
+        values = tuple(kind(w) for w in text.split(","))
+    except ValueError:
+        raise InvalidConfig("values", text, f"comma-separated {SHORT[spec.vary]} values") from None
+    check(len(set(values)) == len(values), "values", text, "distinct values")
+    return values
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    ns = parser.parse_args(argv)
+    spec = SPECS[ns.figure]
+    today = datetime.date.today().isoformat()
+    env_name = ns.env or ("point" if ns.quick else "push")
+    out = ns.out or (
+        os.path.join("runs", today, f"{ns.figure}-{env_name}-quick")
+        if ns.quick
+        else os.path.join("experiments", "results", today, f"{ns.figure}-{env_name}")
+    )
+    use_compile_cache(ns.compile_cache)
+    try:
+        if ns.replot or ns.resume:
+            check(not (ns.replot and ns.resume), "replot", True, "given without --resume")
+            if ns.resume:
+                train(out, load_record(out), ns.quiet, resume=True)
+        else:
+            check(env_name in envs.names(), "env", env_name, "one of " + ", ".join(envs.names()))
+            check(not ns.quick or env_name == "point", "env", env_name, "point with --quick")
+            if ns.methods is None:
+                methods = spec.methods
+            else:
+                check(ns.figure == "fig3", "methods", ns.methods, "given only for fig3")
+                methods = parse_methods(ns.methods, spec.methods)
+            budget = ns.episodes or (QUICK_EPISODES if ns.quick else default_budget(env_name))
+            sets = parse_sets(ns.set, methods)
+            values = _values(spec, ns.values)
+            check_out(out)
+            plans = plan(spec, env_name, methods, ns.seeds, budget, sets, out, values, ns.quick)
+            record = {
+                "figure": ns.figure,
+                "env": env_name,
+                "methods": list(methods),
+                "seeds": ns.seeds,
+                "budget_episodes": budget,
+                "device": device_name(),
+                "date": today,
+                "command": shlex.join(["python", "-m", "splid_jax.figures", *argv]),
+                "runs": describe(plans),
+            }
+            os.makedirs(out, exist_ok=True)
+            train(out, record, ns.quiet)
+        png, table = render(out, ns.quiet)
+    except InvalidConfig as err:
+        print(f"{parser.prog}: error: {err}", file=sys.stderr)
+        return 2
+    except loop.Interrupted as stop:
+        progress.show(f"stopped; continue with: python -m splid_jax.figures {ns.figure} --out {out} --resume", ns.quiet)
+        return stop.exit_code
+    except (loop.RunStopped, checkpoint.CheckpointError) as err:
+        print(f"{parser.prog}: error: {err}", file=sys.stderr)
+        return 3
+    progress.show(f"figure: {png}\ntable: {table}", ns.quiet)
+    return 0
+
+
+if __name__ == "__main__":
+    code = main()
+    if code in (130, 143):  # the chunk or compilation the signal cut short may still run in a thread
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    raise SystemExit(code)
