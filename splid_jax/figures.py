@@ -36,7 +36,7 @@ import envs  # noqa: E402
 from envs.base import InvalidConfig, check  # noqa: E402
 from splid_jax import checkpoint, loop, plot, progress  # noqa: E402
 from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache  # noqa: E402
-from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.config import NOT_READ, TASK_DEFAULTS, TrainConfig  # noqa: E402
 
 SPEC = "figure.json"  # the figure's command, device, date and what each method ran
 
@@ -87,7 +87,16 @@ QUICK_EPISODES = 320
 QUICK_FIELDS: dict[str, Any] = dict(
     num_envs=16, eval_every=5, eval_episodes=50, bc_steps=20, batch_size=64, hidden=(32, 32), buffer_size=20_000
 )
-QUICK_METHOD_FIELDS: dict[str, dict[str, Any]] = {}
+QUICK_METHOD_FIELDS: dict[str, dict[str, Any]] = {
+    "her": dict(her_options="hidden=32,32,batch_size=64,n_batches=10,buffer_transitions=20000"),
+    "es": dict(es_options="population=16"),
+}
+
+
+def reads(algo: str, field: str) -> bool:
+    """Whether ``algo`` reads a TrainConfig field, so that a setting given for every method skips
+    those that do not (ES's num_envs is its population's episodes)."""
+    return field not in NOT_READ.get(algo, ()) and not (algo == "es" and field == "num_envs")
 
 
 def default_budget(env: str) -> int:
@@ -143,6 +152,8 @@ def parse_sets(items: Sequence[str], methods: Sequence[str]) -> dict[str | None,
             item,
             "a TrainConfig field other than " + ", ".join(sorted(OWNED)) + " (see python -m splid_jax.train --help)",
         )
+        algo = METHODS[method].fields["algo"] if method else None
+        check(not algo or reads(algo, name), "set", item, f"a field that {method} reads")
         out.setdefault(method or None, {})[name] = _convert(name, value, types[name])
     return out
 
@@ -184,16 +195,15 @@ def plan(
     made: dict[str, envs.GoalEnv] = {}
     plans = []
     for name in methods:
-        fields = {
-            "env": env_name,
-            **(QUICK_FIELDS if quick else {}),
-            **(QUICK_METHOD_FIELDS.get(name, {}) if quick else {}),
-        }
-        fields.update(sets.get(None, {}), **sets.get(name, {}), **METHODS[name].fields)
+        algo = METHODS[name].fields["algo"]
+        shared = {**(QUICK_FIELDS if quick else {}), **sets.get(None, {})}
+        fields = {"env": env_name, **{k: v for k, v in shared.items() if reads(algo, k)}}
+        fields.update(QUICK_METHOD_FIELDS.get(name, {}) if quick else {}, **sets.get(name, {}), **METHODS[name].fields)
         if spec.vary:
             fields[spec.vary] = max(values)  # shapes for the largest H, as a sweep's
-        every = fields.get("eval_every", TASK_DEFAULTS[env_name]["eval_every"])
-        probe = TrainConfig(**fields, iterations=every, run_dir=os.path.join(out, name))
+        if "eval_every" in fields:  # else the default iterations, a multiple of the default eval_every
+            fields["iterations"] = fields["eval_every"]
+        probe = TrainConfig(**fields, run_dir=os.path.join(out, name))
         options = probe.env_options
         if options not in made:
             made[options] = loop.make_env(env_name, **probe.env_overrides())
@@ -387,7 +397,7 @@ def title(record: dict, series: Sequence[Series]) -> str:
 
 def draw(record: dict, series: Sequence[Series]) -> Figure:
     spec = SPECS[record["figure"]]
-    fig = Figure(figsize=(6.5 * len(spec.panels), 5.2), layout="constrained")
+    fig = Figure(figsize=(max(9.0, 6.5 * len(spec.panels)), 5.2), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, len(spec.panels), sharey=True))
     cmap = matplotlib.colormaps["tab10"]
     for i, s in enumerate(series):
@@ -447,8 +457,8 @@ fig6: average return of SPLID with and without SELECT.
 Figures 8 and 9 (SPLID and GCSL on Point2D-FourRooms, Reacher and SawyerDoor) are not offered yet: the
 Reacher and SawyerDoor tasks do not exist.
 
-Each method is one vmapped sweep over its seeds in OUT/METHOD/ (run directories as splid_jax.sweep
-writes them); OUT/figure.json records the command, device, date and what each method ran; the PNG and
+Each method is one vmapped sweep in OUT/METHOD/ (the sweep's checkpoints, one run directory per
+member); OUT/figure.json records the command, device, date and what each method ran; the PNG and the
 CSV (method, episodes, mean and standard error of each measure, seeds, wall-clock seconds of training
 without compilation, iterations and episodes each method ran) lie in OUT.
 Exit codes: 0 done, 2 bad input (nothing trained), 3 a run stopped (NaN), 130 Ctrl-C, 143 SIGTERM
@@ -547,7 +557,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             else:
                 check(ns.figure == "fig3", "methods", ns.methods, "given only for fig3")
                 methods = parse_methods(ns.methods, spec.methods)
-            budget = ns.episodes or (QUICK_EPISODES if ns.quick else default_budget(env_name))
+            budget = ns.episodes
+            if budget is None:
+                budget = QUICK_EPISODES if ns.quick else default_budget(env_name)
             sets = parse_sets(ns.set, methods)
             values = _values(spec, ns.values)
             check_out(out)

@@ -1,0 +1,203 @@
+"""Figures from one command: every method one vmapped sweep on the same episode budget, a PNG and a
+CSV drawn from the run directories alone, and one-line refusals of bad input."""
+
+import csv
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from splid_jax import figures, loop
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+QUICK = ["--quick", "--seeds", "2", "--episodes", "160", "--set", "eval_episodes=20", "--quiet"]
+TRAINED = ("splid", "no-select", "gcsl")
+
+
+def rows(path: Path) -> list[dict]:
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+@pytest.fixture(scope="module")
+def fig3(tmp_path_factory):
+    """One quick Figure 3 of three methods, trained once for the tests that read it."""
+    out = tmp_path_factory.mktemp("fig3") / "out"
+    code = figures.main(["fig3", "--methods", ",".join(TRAINED), "--out", str(out), *QUICK])
+    return code, out
+
+
+@pytest.mark.slow
+def test_quick_fig3_writes_a_figure_and_a_table_with_equal_budgets(fig3):
+    code, out = fig3
+    assert code == 0
+    png, table = out / "fig3-point.png", out / "fig3-point.csv"
+    assert png.read_bytes()[:8] == PNG_MAGIC and png.stat().st_size > 20_000
+    table = rows(table)
+    assert {r["method"] for r in table} == set(TRAINED)
+    for r in table:
+        for measure in ("eval_success", "eval_success_final"):
+            assert 0 <= float(r[f"{measure}_mean"]) <= 1 and float(r[f"{measure}_sem"]) >= 0
+        assert r["seeds"] == "2" and float(r["wall_s"]) >= 0
+    last = {m: max(int(r["episodes"]) for r in table if r["method"] == m) for m in TRAINED}
+    assert set(last.values()) == {160}  # 10 iterations of 16 episodes each
+    assert {r["run_episodes"] for r in table} == {"160"} and {r["budget_episodes"] for r in table} == {"160"}
+    # each method's members are a sweep's run dirs, one metrics file per seed
+    for method in TRAINED:
+        assert (out / method / "sweep.json").is_file()
+        assert sorted(p.parent.name for p in (out / method).glob("s*/metrics.jsonl")) == ["s0", "s1"]
+    record = json.loads((out / "figure.json").read_text())
+    assert record["command"].startswith("python -m splid_jax.figures fig3")
+    assert record["device"] and record["date"]
+
+
+@pytest.mark.slow
+def test_replot_redraws_from_the_run_dirs_without_training(fig3, monkeypatch):
+    code, out = fig3
+    assert code == 0
+    table = (out / "fig3-point.csv").read_text()
+    runs = {p: p.read_bytes() for p in out.glob("*/*/metrics.jsonl")}
+    (out / "fig3-point.png").unlink()
+    (out / "fig3-point.csv").unlink()
+
+    def no_training(*args, **kwargs):
+        raise AssertionError("--replot trained")
+
+    monkeypatch.setattr(loop, "run", no_training)
+    assert figures.main(["fig3", "--replot", "--out", str(out), "--quiet"]) == 0
+    assert (out / "fig3-point.png").read_bytes()[:8] == PNG_MAGIC
+    assert (out / "fig3-point.csv").read_text() == table
+    assert {p: p.read_bytes() for p in out.glob("*/*/metrics.jsonl")} == runs
+
+
+@pytest.mark.slow
+def test_a_figure_dir_is_never_trained_into_again(fig3, capsys):
+    code, out = fig3
+    assert code == 0
+    before = {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()}
+    assert figures.main(["fig3", "--methods", "splid", "--out", str(out), *QUICK]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "invalid out=" in err and "--replot" in err
+    assert {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()} == before
+
+
+@pytest.mark.slow
+def test_resume_of_a_finished_figure_trains_nothing_and_redraws_it(fig3):
+    code, out = fig3
+    assert code == 0
+    runs = {p: p.read_bytes() for p in out.glob("*/*/metrics.jsonl")}
+    assert figures.main(["fig3", "--resume", "--out", str(out), "--quiet"]) == 0
+    assert {p: p.read_bytes() for p in out.glob("*/*/metrics.jsonl")} == runs
+    assert (out / "fig3-point.png").read_bytes()[:8] == PNG_MAGIC
+
+
+@pytest.mark.parametrize(
+    "args, field",
+    [
+        (["fig3", "--methods", "splid,dqn"], "methods"),
+        (["fig3", "--methods", "splid,splid"], "methods"),
+        (["fig4", "--methods", "gcsl"], "methods"),
+        (["fig3", "--set", "learning_rate=fast"], "learning_rate"),
+        (["fig3", "--set", "seed=3"], "set"),
+        (["fig3", "--set", "dqn.bc_steps=3"], "set"),
+        (["fig3", "--set", "es.bc_steps=3"], "set"),
+        (["fig3", "--values", "1,2"], "values"),
+        (["fig4", "--values", "1,x"], "values"),
+        (["fig3", "--seeds", "0"], "seeds"),
+        (["fig3", "--episodes", "0"], "episodes"),
+        (["fig3", "--env", "push"], "env"),
+    ],
+)
+def test_a_bad_argument_is_one_line_and_exit_2(capsys, tmp_path, args, field):
+    out = tmp_path / "out"
+    assert figures.main([*args, "--quick", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+    assert not out.exists()
+
+
+def test_replot_of_a_dir_without_a_figure_is_one_line(capsys, tmp_path):
+    assert figures.main(["fig3", "--replot", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "figure.json" in err
+
+
+def test_help_names_the_figures_it_leaves_out(capsys):
+    with pytest.raises(SystemExit) as exc:
+        figures.main(["--help"])
+    assert exc.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "Figures 8 and 9" in text and "Reacher and SawyerDoor tasks do not exist" in text
+
+
+def test_every_method_runs_whole_chunks_nearest_the_budget(tmp_path):
+    spec = figures.SPECS["fig3"]
+    sets = figures.parse_sets(["eval_every=5", "num_envs=16", "gcsl.num_envs=24"], ("splid", "gcsl"))
+    plans = {p.method: p for p in figures.plan(spec, "point", ("splid", "gcsl"), 3, 320, sets, str(tmp_path))}
+    assert (plans["splid"].base.iterations, plans["splid"].episodes_per_iteration) == (20, 16)
+    # 320 / (24 x 5) = 2.7 chunks: 3 chunks, 360 episodes, as the record says
+    assert (plans["gcsl"].base.iterations, plans["gcsl"].episodes_per_iteration) == (15, 24)
+    assert figures.describe(plans.values())["gcsl"]["episodes"] == 360
+    assert [m.seed for m in plans["gcsl"].lanes] == [0, 1, 2]
+    assert not os.path.exists(tmp_path / "splid")  # planning writes nothing
+
+
+def test_fig4_is_one_sweep_over_h_and_seeds(tmp_path):
+    spec = figures.SPECS["fig4"]
+    (p,) = figures.plan(spec, "point", ("splid",), 2, 320, {None: {}}, str(tmp_path), quick=True)
+    assert p.base.horizon == 16  # shapes for the largest H
+    assert [(m.horizon, m.seed) for m in p.lanes] == [(h, s) for h in (1, 2, 4, 8, 16) for s in (0, 1)]
+    assert os.path.basename(p.lanes[2].run_dir) == "H2-s0"
+
+
+def fake_run(run_dir: Path, config: dict, success: list[float]):
+    run_dir.mkdir(parents=True)
+    (run_dir / "config.json").write_text(json.dumps(config))
+    with open(run_dir / "metrics.jsonl", "w") as fh:
+        for i, s in enumerate(success, 1):
+            rec = dict(iteration=5 * i, episodes=80 * i, env_steps=4000 * i, select_steps=0, eval_success=s,
+                       eval_success_final=s / 2, eval_return=10 * s, wall_s=float(i))  # fmt: skip
+            fh.write(json.dumps(rec) + "\n")
+
+
+def fake_figure(out: Path, figure: str, methods: dict[str, list[tuple[dict, list[float]]]]) -> dict:
+    """A figure dir as the command leaves it, with made-up metrics."""
+    runs = {}
+    for method, members in methods.items():
+        names = []
+        for config, success in members:
+            name = f"{figures.member_name(config['seed'], figures.SPECS[figure].vary, config.get('horizon'))}"
+            fake_run(out / method / name, config, success)
+            names.append({**config, "run_dir": name})
+        runs[method] = {"iterations": 10, "episodes_per_iteration": 16, "episodes": 160, "members": names}
+    record = dict(figure=figure, env="point", methods=list(methods), seeds=2, budget_episodes=160, device="CPU",
+                  date="2026-11-23", command="python -m splid_jax.figures", runs=runs)  # fmt: skip
+    (out / figures.SPEC).write_text(json.dumps(record))
+    return record
+
+
+def test_mean_and_standard_error_over_seeds(tmp_path):
+    fake_figure(tmp_path, "fig6", {
+        "splid": [({"seed": 0, "algo": "splid"}, [0.2, 0.6]), ({"seed": 1, "algo": "splid"}, [0.4, 1.0])],
+        "no-select": [({"seed": 0, "algo": "splid", "select": False}, [0.1, 0.3])],
+    })  # fmt: skip
+    png, table = figures.render(str(tmp_path), quiet=True)
+    table = rows(Path(table))
+    splid = [r for r in table if r["method"] == "splid"]
+    assert [float(r["eval_return_mean"]) for r in splid] == pytest.approx([3.0, 8.0])
+    assert [float(r["eval_return_sem"]) for r in splid] == pytest.approx([1.0, 2.0])  # std (ddof 1) / sqrt(2)
+    assert [r["eval_return_sem"] for r in table if r["method"] == "no-select"] == ["", ""]  # one seed: none
+    assert Path(png).read_bytes()[:8] == PNG_MAGIC
+
+
+def test_fig4_draws_one_series_per_h(tmp_path):
+    members = [({"seed": s, "algo": "splid", "horizon": h}, list(np.linspace(0.1, h / 8, 3))) for h in (2, 8)
+               for s in (0, 1)]  # fmt: skip
+    fake_figure(tmp_path, "fig4", {"splid": members})
+    _, table = figures.render(str(tmp_path), quiet=True)
+    table = rows(Path(table))
+    assert sorted({r["horizon"] for r in table}) == ["2", "8"]
+    assert all(r["seeds"] == "2" for r in table)
+    assert float([r for r in table if r["horizon"] == "8"][-1]["eval_success_mean"]) == pytest.approx(1.0)
