@@ -33,11 +33,26 @@ class Parser(argparse.ArgumentParser):
         super().__init__(allow_abbrev=False, **kw)
 
     def format_help(self) -> str:
+        listings = {"env_options": task_fields, "her_options": her_fields, "es_options": es_fields}
         for action in self._actions:
-            if action.dest == "env_options" and not getattr(action, "fields_listed", False):
-                action.help = f"{action.help}. Fields and defaults: {task_fields()}".replace("%", "%%")
+            if action.dest in listings and not getattr(action, "fields_listed", False):
+                action.help = f"{action.help}. Fields and defaults: {listings[action.dest]()}".replace("%", "%%")
                 action.fields_listed = True
         return super().format_help()
+
+
+def her_fields() -> str:
+    from splid_jax.config import option_fields
+    from splid_jax.her import HerConfig
+
+    return option_fields(HerConfig)
+
+
+def es_fields() -> str:
+    from splid_jax.config import option_fields
+    from splid_jax.es import EsConfig
+
+    return option_fields(EsConfig)
 
 
 def task_fields() -> str:
@@ -71,9 +86,14 @@ _TYPES = {"int": int, "float": float, "str": str, "str | None": str, "tuple[int,
 
 
 def add_config_flags(
-    parser: argparse.ArgumentParser, cls, per_task: dict[str, dict] | None = None, exclude: frozenset[str] = frozenset()
+    parser: argparse.ArgumentParser,
+    cls,
+    per_task: dict[str, dict] | None = None,
+    exclude: frozenset[str] = frozenset(),
+    per_algo: dict[str, dict[str, dict]] | None = None,
 ) -> None:
-    """One flag per field (less ``exclude``); every default is None so that explicit values can be told apart."""
+    """One flag per field (less ``exclude``); every default is None so that explicit values can be told
+    apart. ``per_algo``: a learner's own defaults per task, shown after the task defaults they replace."""
     for f in dataclasses.fields(cls):
         if f.name in exclude:
             continue
@@ -83,11 +103,28 @@ def add_config_flags(
             help_text += f" (default: {f.default})"
         elif per_task and any(f.name in d for d in per_task.values()):
             shown = ", ".join(f"{task} {_show(d[f.name])}" for task, d in per_task.items() if f.name in d)
+            for algo, tasks in (per_algo or {}).items():
+                values: dict[str, list[str]] = {}
+                for task, d in tasks.items():
+                    if f.name in d:
+                        values.setdefault(_show(d[f.name]), []).append(task)
+                shown += "".join(f"; {algo} on {', '.join(ts)}: {v}" for v, ts in values.items())
             help_text += f" (default per task: {shown})"
         if f.type == "bool":
             parser.add_argument(flag, action=argparse.BooleanOptionalAction, default=None, help=help_text)
         else:
             parser.add_argument(flag, type=_TYPES[f.type], default=None, help=help_text, metavar=f.name.upper())
+
+
+def refuse_unread(given: dict, algo: str) -> None:
+    """A setting given on the command line that ``algo`` does not read is a mistake, not a no-op."""
+    from envs.base import InvalidConfig
+    from splid_jax.config import NOT_READ
+
+    for name in NOT_READ.get(algo, ()):
+        if name in given:
+            allowed = f"unset with --algo {algo}, which does not read it (its own settings: --{algo}-options)"
+            raise InvalidConfig(name, given[name], allowed)
 
 
 def _show(value) -> str:

@@ -9,7 +9,7 @@ import os
 from typing import Any
 
 import envs
-from envs.base import check
+from envs.base import InvalidConfig, check
 
 
 def _f(default, help: str, **kw):
@@ -21,7 +21,11 @@ class TrainConfig:
     env: str = _f("point", "task: " + ", ".join(envs.names()))
     seed: int = _f(0, "PRNG seed; the same seed on the same device gives the same run")
     iterations: int = _f(None, "SPLID iterations (explore, select, behaviour cloning); a multiple of eval_every")
-    num_envs: int = _f(None, "episodes explored in parallel per iteration")
+    num_envs: int = _f(
+        None,
+        "episodes explored in parallel per iteration; es: not set, its population plays "
+        "es.population x es.episodes_per_member episodes per generation",
+    )
     sigma: float = _f(1.0, "std of the Gaussian exploration noise added to the policy's action")
     horizon: int = _f(8, "learning horizon H: hindsight goals come from 1..H steps ahead")
     algo: str = _f(
@@ -55,7 +59,9 @@ class TrainConfig:
         "Polyak average of the cloned parameters that acts (explore, SELECT, eval): "
         "acting = d * acting + (1 - d) * cloned after each BC step; 0 acts with the cloned ones",
     )
-    hidden: tuple[int, ...] = _f(None, "hidden layer widths of the policy MLP, e.g. 64,64,64")
+    hidden: tuple[int, ...] = _f(
+        None, "hidden layer widths of the policy MLP, e.g. 64,64,64 (her: see --her-options hidden)"
+    )
     normalise: bool = _f(None, "normalise policy inputs with running mean and std")
     eval_every: int = _f(None, "iterations per compiled chunk; evaluation, logging and checkpoints come between")
     eval_episodes: int = _f(None, "episodes of the deterministic policy per evaluation")
@@ -64,11 +70,30 @@ class TrainConfig:
     env_options: str = _f(
         "", "task fields as KEY=VALUE[,KEY=VALUE...], e.g. finger=capsule or substeps=20,timestep=0.002"
     )
+    her_options: str = _f("", "her only: HER's settings as KEY=VALUE[,KEY=VALUE...], e.g. batch_size=256,hidden=64,64")
+    es_options: str = _f("", "es only: ES's settings as KEY=VALUE[,KEY=VALUE...], e.g. population=512,sigma=0.05")
 
     def __post_init__(self):
         check(self.env in envs.names(), "env", self.env, "one of " + ", ".join(envs.names()))
-        defaults = TASK_DEFAULTS[self.env]
-        for name, value in defaults.items():  # fill per-task defaults for fields left at None
+        check(self.algo in ALGOS, "algo", self.algo, "one of " + ", ".join(ALGOS))
+        for algo in ("her", "es"):  # each learner's own settings, refused for another
+            text = getattr(self, f"{algo}_options")
+            check(not text or self.algo == algo, f"{algo}_options", text, f"empty unless algo={algo}")
+        if self.algo == "her":
+            self.her_config()
+        if self.algo == "es":  # the population sets the episodes per generation
+            es = self.es_config()
+            per_generation = es.population * es.episodes_per_member
+            check(
+                self.num_envs in (None, per_generation),
+                "num_envs",
+                self.num_envs,
+                f"unset with algo=es: its population plays es.population x es.episodes_per_member = "
+                f"{per_generation} episodes per generation",
+            )
+            object.__setattr__(self, "num_envs", per_generation)
+        defaults = {**TASK_DEFAULTS[self.env], **ALGO_DEFAULTS.get(self.algo, {}).get(self.env, {})}
+        for name, value in defaults.items():  # fill per-algorithm, then per-task defaults for fields left at None
             if getattr(self, name) is None:
                 object.__setattr__(self, name, value)
         object.__setattr__(self, "hidden", tuple(int(w) for w in self.hidden))
@@ -82,7 +107,6 @@ class TrainConfig:
                 check(math.isfinite(getattr(self, f.name)), f.name, getattr(self, f.name), "a finite number")
         check(self.iterations >= 1, "iterations", self.iterations, "an integer >= 1")
         check(self.num_envs >= 1, "num_envs", self.num_envs, "an integer >= 1")
-        check(self.algo in ALGOS, "algo", self.algo, "one of " + ", ".join(ALGOS))
         check(self.relabel in RELABELS, "relabel", self.relabel, "one of " + ", ".join(RELABELS))
         check(self.gcsl_relabel in ("final", "future"), "gcsl_relabel", self.gcsl_relabel, "final or future")
         check(self.pchid_every >= 0, "pchid_every", self.pchid_every, "an integer >= 0")
@@ -112,6 +136,18 @@ class TrainConfig:
     def env_overrides(self) -> dict[str, Any]:
         return envs.parse_overrides(self.env_options)
 
+    def her_config(self):
+        """``her.HerConfig`` from ``her_options`` (imported here: her.py imports this module)."""
+        from splid_jax.her import HerConfig
+
+        return parse_options(HerConfig, self.her_options, "her_options", "her")
+
+    def es_config(self):
+        """``es.EsConfig`` from ``es_options``."""
+        from splid_jax.es import EsConfig
+
+        return parse_options(EsConfig, self.es_options, "es_options", "es")
+
     def check_env(self, env: envs.GoalEnv) -> None:
         """Checks that need the task's sizes."""
         check(
@@ -123,6 +159,57 @@ class TrainConfig:
 
     def to_json(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
+
+
+def parse_options(cls, text: str, field: str, prefix: str):
+    """A learner's config dataclass (``HerConfig``, ``EsConfig``) from ``KEY=VALUE[,KEY=VALUE...]``, read
+    by ``envs.parse_overrides``; a tuple field takes its widths comma-separated too (``hidden=64,64``).
+    A bad key or value fails naming ``prefix.KEY``."""
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    items: list[str] = []
+    for part in (p.strip() for p in text.split(",")):
+        previous = items[-1].partition("=")[0].strip() if items else ""
+        if part and "=" not in part and previous in fields and str(fields[previous].type).startswith("tuple"):
+            items[-1] += ":" + part  # a further width of the tuple before
+        else:
+            items.append(part)
+    try:
+        overrides = envs.parse_overrides(",".join(items), field)
+    except InvalidConfig:
+        raise InvalidConfig(field, text, f"KEY=VALUE[,KEY=VALUE...] with {prefix} fields as keys") from None
+    values = {}
+    for key, value in overrides.items():
+        where = f"{prefix}.{key}"
+        check(key in fields, where, value, "one of the fields " + ", ".join(fields))
+        values[key] = _typed(where, str(fields[key].type), value)
+    return cls(**values)
+
+
+def _typed(where: str, kind: str, value):
+    if kind == "bool":
+        words = {"true": True, "1": True, "false": False, "0": False}
+        check(str(value).lower() in words, where, value, "true or false")
+        return words[str(value).lower()]
+    if kind.startswith("tuple"):
+        try:
+            return tuple(int(w) for w in str(value).split(":"))
+        except ValueError:
+            raise InvalidConfig(where, str(value).replace(":", ","), "comma-separated integers, e.g. 64,64") from None
+    if kind == "int":
+        check(isinstance(value, int), where, value, "an integer")
+    if kind == "float":
+        check(isinstance(value, int | float) and math.isfinite(value), where, value, "a finite number")
+        return float(value)
+    return str(value) if kind == "str" else value
+
+
+def option_fields(cls) -> str:
+    """``field=default (help); ...`` of a learner's config dataclass, for ``--help``."""
+    shown = []
+    for f in dataclasses.fields(cls):
+        default = ",".join(map(str, f.default)) if isinstance(f.default, tuple) else f.default
+        shown.append(f"{f.name}={default} ({f.metadata.get('help', '')})")
+    return "; ".join(shown)
 
 
 ALGOS = ("splid", "gcsl", "pchid", "her", "es")
@@ -176,3 +263,24 @@ TASK_DEFAULTS: dict[str, dict[str, Any]] = {
     "slide": {**_FETCH, "iterations": 50, "num_envs": 1024},
     "pick_and_place": {**_FETCH, "iterations": 50, "num_envs": 1024},
 }
+# A learner's own defaults per task, taken before TASK_DEFAULTS for fields left at None. HER on the
+# Fetch tasks runs as OpenAI Baselines: a cycle explores 2 episodes on each of 8 workers (num_envs 16,
+# with HerConfig's batch of 2048 = 8 x 256 averaged gradients) and an epoch of 50 cycles is evaluated
+# (eval_every 50). Push's 1,250 cycles are 20,000 episodes; Slide's and PickAndPlace's 3,200 the
+# 51,200 SPLID runs there.
+_HER_FETCH = dict(num_envs=16, eval_every=50)
+ALGO_DEFAULTS: dict[str, dict[str, dict[str, Any]]] = {
+    "her": {
+        "reach": {**_HER_FETCH, "iterations": 250},
+        "push": {**_HER_FETCH, "iterations": 1250},
+        "slide": {**_HER_FETCH, "iterations": 3200},
+        "pick_and_place": {**_HER_FETCH, "iterations": 3200},
+    },
+}
+# Fields HER and ES do not read: given on the command line with either, they are refused.
+NOT_READ: dict[str, tuple[str, ...]] = {
+    "her": ("sigma", "select", "relabel", "select_radius", "gcsl_relabel", "pchid_every", "select_lanes",
+            "buffer_size", "batch_size", "bc_steps", "learning_rate", "policy_ema", "hidden", "normalise"),
+    "es": ("sigma", "select", "relabel", "select_radius", "gcsl_relabel", "pchid_every", "select_lanes",
+           "buffer_size", "batch_size", "bc_steps", "learning_rate", "policy_ema", "normalise"),
+}  # fmt: skip

@@ -3,8 +3,8 @@ deterministic policy's parameters; each member of a population plays whole episo
 fitness is the episode return under the task's sparse reward.
 
 One iteration is one generation: ask a population, roll every member from fresh resets (all members
-and episodes as one batch of envs), tell the returns. ``cfg.num_envs``, ``cfg.sigma`` and
-``cfg.learning_rate`` are SPLID's and unused here: the population sets the episodes per generation."""
+and episodes as one batch of envs), tell the returns. ``cfg.sigma`` and ``cfg.learning_rate`` are
+SPLID's and unused here; ``TrainConfig`` sets ``cfg.num_envs`` to the episodes per generation."""
 
 from __future__ import annotations
 
@@ -42,8 +42,8 @@ def _f(default, help: str):
 
 @dataclasses.dataclass(frozen=True)
 class EsConfig:
-    """ES's own settings (errors name them ``es.FIELD``); SPLID's ``sigma``, ``learning_rate`` and
-    ``num_envs`` in ``TrainConfig`` do not apply to ES."""
+    """ES's own settings (errors name them ``es.FIELD``); SPLID's ``sigma`` and ``learning_rate`` in
+    ``TrainConfig`` do not apply to ES, and its ``num_envs`` follows the population."""
 
     population: int = _f(256, "ES population per generation (even when antithetic); each member plays its episodes")
     sigma: float = _f(0.02, "std of the Gaussian parameter perturbations (Salimans et al.: 0.02)")

@@ -38,7 +38,9 @@ class HerConfig:
     actor_lr: float = _f(1e-3, "Adam learning rate of the actor")
     critic_lr: float = _f(1e-3, "Adam learning rate of the critic")
     batch_size: int = _f(
-        256, "transitions per gradient step (Baselines: 256 per MPI worker, whose gradients are averaged)"
+        2048,
+        "transitions per gradient step: Baselines averages the gradients of 8 MPI workers' batches of 256, "
+        "2048 in effect",
     )
     buffer_transitions: int = _f(1_000_000, "replay capacity in transitions, stored as whole episodes (FIFO)")
     n_batches: int = _f(40, "gradient steps per iteration (Baselines' n_batches per cycle)")

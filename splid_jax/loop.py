@@ -73,12 +73,19 @@ def env_settings(env: envs.GoalEnv) -> dict:
 
 def make_algorithm(cfg: TrainConfig, env: envs.GoalEnv) -> Algorithm:
     """The learner ``cfg.algo`` names, built for ``env``."""
-    name = getattr(cfg, "algo", "splid")
-    if name in ("splid", "gcsl", "pchid"):
+    if cfg.algo in ("splid", "gcsl", "pchid"):
         from splid_jax.trainer import Trainer
 
         return Trainer(env, cfg)
-    raise InvalidConfig("algo", name, "one of splid, gcsl, pchid")
+    if cfg.algo == "her":
+        from splid_jax.her import HER
+
+        return HER(env, cfg, cfg.her_config())
+    if cfg.algo == "es":
+        from splid_jax.es import ES
+
+        return ES(env, cfg, cfg.es_config())
+    raise InvalidConfig("algo", cfg.algo, "one of splid, gcsl, pchid, her, es")
 
 
 def identity(cfg: TrainConfig) -> dict:

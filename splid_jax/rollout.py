@@ -18,8 +18,7 @@ from envs.base import InvalidConfig, step_batch
 from splid_jax import checkpoint
 from splid_jax.cli import add_compile_cache_flag, use_compile_cache
 from splid_jax.config import TrainConfig
-from splid_jax.train import env_settings, make_env
-from splid_jax.trainer import Trainer
+from splid_jax.loop import env_settings, make_algorithm, make_env
 
 DESCRIPTION = (
     "Roll a run's deterministic policy out, report its success and draw the episodes: their paths, "
@@ -44,9 +43,11 @@ def load_config(run_dir: str) -> TrainConfig:
 
 
 def load_policy(cfg: TrainConfig, step: int | None = None):
-    """The task, the trainer and the trained state of checkpoint ``step`` (default: the newest)."""
+    """The task, the run's algorithm and its trained state at checkpoint ``step`` (default: the newest).
+    Every algorithm acts through ``algo.policy`` with the ``networks.PolicyState`` at ``state.policy``:
+    SPLID's, GCSL's and PCHID's cloned policy, HER's actor, ES's search mean."""
     env = make_env(cfg.env, **cfg.env_overrides())
-    trainer = Trainer(env, cfg)
+    trainer = make_algorithm(cfg, env)
     like = jax.eval_shape(trainer.init, jax.random.PRNGKey(0))
     step, state, meta = checkpoint.restore(cfg.run_dir, like, step=step)
     saved, now = meta["env"], env_settings(env)

@@ -23,8 +23,15 @@ import sys  # noqa: E402
 
 from envs.base import InvalidConfig, check  # noqa: E402
 from splid_jax import checkpoint, loop, plot, progress  # noqa: E402
-from splid_jax.cli import Parser, add_compile_cache_flag, add_config_flags, explicit_values, use_compile_cache  # noqa: E402
-from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.cli import (  # noqa: E402
+    Parser,
+    add_compile_cache_flag,
+    add_config_flags,
+    explicit_values,
+    refuse_unread,
+    use_compile_cache,
+)
+from splid_jax.config import ALGO_DEFAULTS, TASK_DEFAULTS, TrainConfig  # noqa: E402
 from splid_jax.loop import RunStopped, make_env  # noqa: E402
 
 
@@ -98,7 +105,9 @@ def build_parser() -> Parser:
         epilog="Exit codes as train's: 0 done, 2 bad input (nothing written), 3 stopped, 130 Ctrl-C, 143 SIGTERM.",
     )
     # --sigmas and --horizons replace the single values
-    add_config_flags(parser, TrainConfig, TASK_DEFAULTS, exclude=frozenset({"sigma", "horizon"}))
+    add_config_flags(
+        parser, TrainConfig, TASK_DEFAULTS, exclude=frozenset({"sigma", "horizon"}), per_algo=ALGO_DEFAULTS
+    )
     parser.add_argument("--seeds", type=int, default=4, help="seeds per grid point (default: 4)")
     parser.add_argument("--sigmas", default="1.0", help="comma-separated sigma values (default: 1.0)")
     parser.add_argument("--horizons", default="8", help="comma-separated H values (default: 8)")
@@ -136,6 +145,7 @@ def main(argv: list[str] | None = None) -> int:
         if ns.resume:
             cfg, lanes = resume_configs(ns.resume, given)
         else:
+            refuse_unread(given, given.get("algo", "splid"))
             given.setdefault("run_dir", os.path.join("runs", f"sweep-{given.get('env', 'point')}"))
             sigmas, horizons = _values("sigmas", ns.sigmas, float), _values("horizons", ns.horizons, int)
             grid = members(ns.seeds, sigmas, horizons, base_seed=given.get("seed", 0))

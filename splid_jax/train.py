@@ -20,8 +20,15 @@ import sys  # noqa: E402
 import envs  # noqa: E402
 from envs.base import InvalidConfig  # noqa: E402
 from splid_jax import checkpoint, loop, progress  # noqa: E402
-from splid_jax.cli import Parser, add_compile_cache_flag, add_config_flags, explicit_values, use_compile_cache  # noqa: E402
-from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.cli import (  # noqa: E402
+    Parser,
+    add_compile_cache_flag,
+    add_config_flags,
+    explicit_values,
+    refuse_unread,
+    use_compile_cache,
+)
+from splid_jax.config import ALGO_DEFAULTS, TASK_DEFAULTS, TrainConfig  # noqa: E402
 from splid_jax.loop import MAY_CHANGE_ON_RESUME, RunStopped, env_settings, make_env  # noqa: E402
 
 __all__ = ["RunStopped", "build_parser", "config_from_cli", "env_settings", "main", "make_env", "run"]
@@ -35,11 +42,12 @@ def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False,
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(
         prog="python -m splid_jax.train",
-        description="Train a goal-conditioned policy (SPLID: explore, SELECT by first hit time, behaviour cloning).",
+        description="Train a goal-conditioned policy: SPLID (explore, SELECT by first hit time, behaviour "
+        "cloning) or a baseline of the paper's comparison (--algo).",
         epilog="Exit codes: 0 done, 2 bad input (nothing written), 3 stopped on NaN or an unreadable checkpoint, "
         "130 Ctrl-C, 143 SIGTERM (both keep the newest whole state as a checkpoint for --resume).",
     )
-    add_config_flags(parser, TrainConfig, TASK_DEFAULTS)
+    add_config_flags(parser, TrainConfig, TASK_DEFAULTS, per_algo=ALGO_DEFAULTS)
     parser.add_argument("--resume", metavar="RUN_DIR", help="continue the run saved in RUN_DIR (its config.json)")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_compile_cache_flag(parser)
@@ -49,6 +57,7 @@ def build_parser() -> argparse.ArgumentParser:
 def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
     given = explicit_values(TrainConfig, ns)
     if ns.resume is None:
+        refuse_unread(given, given.get("algo", "splid"))
         return TrainConfig(**given), False
     path = os.path.join(ns.resume, "config.json")
     if not os.path.isfile(path):
@@ -65,6 +74,7 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
     for k, v in given.items():
         if k not in MAY_CHANGE_ON_RESUME and v != saved.get(k) and not (isinstance(v, tuple) and list(v) == saved[k]):
             raise InvalidConfig(k, v, f"{saved.get(k)!r} as in the run being resumed (only iterations may change)")
+    refuse_unread(given, saved.get("algo", "splid"))
     saved.update(given, run_dir=ns.resume)
     return TrainConfig(**saved), True
 

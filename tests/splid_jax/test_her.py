@@ -17,7 +17,7 @@ from splid_jax.config import TrainConfig
 from splid_jax.her import HER, HerConfig
 
 CFG = dict(env="point", num_envs=16, iterations=150, eval_every=25, eval_episodes=256)
-HER_CFG = dict(hidden=(64, 64, 64), buffer_transitions=100_000)
+HER_CFG = dict(hidden=(64, 64, 64), buffer_transitions=100_000, batch_size=256)
 CHUNKS = 6  # 150 cycles, 2,400 episodes
 
 

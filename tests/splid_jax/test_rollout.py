@@ -197,3 +197,31 @@ def test_paths_figure_has_a_title_and_a_legend():
     assert fig.axes[0].get_title() == "point: iteration 4"
     (legend,) = fig.legends
     assert [t.get_text() for t in legend.get_texts()] == ["reached its goal", "did not", "start", "goal", "wall"]
+
+
+@pytest.mark.parametrize(
+    "algo,options",
+    [("her", {"her_options": "hidden=8,buffer_transitions=500"}), ("es", {"es_options": "population=4"})],
+)
+def test_rollout_acts_as_the_evaluation_of_a_her_or_es_run(tmp_path, capsys, algo, options):
+    """HER's actor and ES's search mean both sit at ``state.policy``; rollout rolls what the loop evaluates."""
+    from splid_jax.evaluate import evaluate
+    from splid_jax.loop import make_algorithm
+
+    run_dir = tmp_path / "run"
+    cfg = TrainConfig(env="point", algo=algo, iterations=1, eval_every=1, hidden=(8,) if algo == "es" else None,
+                      run_dir=str(run_dir), **options)  # fmt: skip
+    env = make_env(cfg.env)
+    algo_ = make_algorithm(cfg, env)
+    state = algo_.init(jax.random.PRNGKey(1))
+    checkpoint.save(run_dir, 0, state, {"env": env_settings(env)})
+    (run_dir / "config.json").write_text(json.dumps(cfg.to_json()))
+
+    _, loaded, pstate, step = rollout.load_policy(rollout.load_config(str(run_dir)))
+    assert step == 0 and type(loaded).__name__ == algo.upper()
+    states = rollout.rollout(env, loaded, pstate.policy, jax.random.PRNGKey(3), 16)
+    evaluated = evaluate(env, algo_.policy, state.policy, jax.random.PRNGKey(3), 16)
+    succ = np.asarray(states.success[1:] & ~states.invalid[1:])
+    assert succ.any(axis=0).mean() == pytest.approx(float(evaluated["eval_success"]))
+    assert rollout.main([str(run_dir), "--episodes", "4"]) == 0
+    assert "iteration 0" in capsys.readouterr().out
