@@ -210,7 +210,7 @@ def plan(
         env = made[options]
         probe.check_env(env)
         per_iteration = loop.make_algorithm(probe, env).counters(1, 0)["episodes"]
-        chunks = max(1, round(budget / (per_iteration * probe.eval_every)))
+        chunks = max(1, math.floor(budget / (per_iteration * probe.eval_every) + 0.5))  # nearest, half up
         base = dataclasses.replace(probe, iterations=chunks * probe.eval_every)
         grid = [(s, v) for v in (values if spec.vary else (None,)) for s in range(seeds)]
         lanes = tuple(

@@ -142,6 +142,10 @@ def test_every_method_runs_whole_chunks_nearest_the_budget(tmp_path):
     assert figures.describe(plans.values())["gcsl"]["episodes"] == 360
     assert [m.seed for m in plans["gcsl"].lanes] == [0, 1, 2]
     assert not os.path.exists(tmp_path / "splid")  # planning writes nothing
+    # a tie rounds up: 400 / (32 x 5) = 2.5 chunks
+    sets = figures.parse_sets(["eval_every=5", "num_envs=32"], ("splid",))
+    (p,) = figures.plan(spec, "point", ("splid",), 1, 400, sets, str(tmp_path))
+    assert p.base.iterations == 15
 
 
 def test_fig4_is_one_sweep_over_h_and_seeds(tmp_path):
