@@ -16,13 +16,12 @@ import jax.extend.core
 import jax.numpy as jnp
 import pytest
 
-_CACHE_HOME = tempfile.mkdtemp(prefix="splid-jax-tests-")
-
 
 def pytest_configure(config):
     # Before the first compilation: the run neither reads nor writes the user's ~/.cache (JAX's
     # programs, the CLI's default --compile-cache, subprocesses' caches), and starts cold every time.
-    os.environ["XDG_CACHE_HOME"] = _CACHE_HOME
+    config.splid_cache_home = tempfile.mkdtemp(prefix="splid-jax-tests-")
+    os.environ["XDG_CACHE_HOME"] = config.splid_cache_home
     from splid_jax.cli import default_compile_cache
 
     os.environ["JAX_COMPILATION_CACHE_DIR"] = default_compile_cache()
@@ -30,7 +29,7 @@ def pytest_configure(config):
 
 
 def pytest_unconfigure(config):
-    shutil.rmtree(_CACHE_HOME, ignore_errors=True)
+    shutil.rmtree(config.splid_cache_home, ignore_errors=True)
 
 
 def _primitives(jaxpr) -> set[str]:
