@@ -494,7 +494,8 @@ class _Loop:
                         + (f" in {bad}" if self.stacked else "")
                         + f"; stopped, the last good state (iteration {iteration}) is kept in {cfg.run_dir}"
                     )
-                per_lane = np.asarray(metrics.pop("select_steps", np.zeros(cfg.eval_every)), np.int64)
+                none = np.zeros((len(lanes), cfg.eval_every))  # learners that replay nothing report no steps
+                per_lane = np.asarray(metrics.pop("select_steps", none), np.int64)
                 per_lane = per_lane.reshape(len(lanes), -1).sum(axis=-1)
                 totals = [t + int(c) for t, c in zip(select_steps, per_lane, strict=True)]
                 now = wall()

@@ -77,6 +77,14 @@ class _Queue(NamedTuple):
     replay_steps: jax.Array  # [] int32
 
 
+def within(env: GoalEnv, achieved: jax.Array, goal: jax.Array, radius: float = 1.0) -> jax.Array:
+    """The task's success test with its threshold scaled by ``radius`` (tasks whose success is a
+    distance threshold): 1 is the task's own; below 1 SELECT asks for the object nearer the goal."""
+    if radius == 1.0:
+        return env.success(achieved, goal)
+    return env.success(goal + (achieved - goal) / radius, goal)
+
+
 def replay_queue(
     env: GoalEnv,
     policy: Policy,
@@ -88,6 +96,7 @@ def replay_queue(
     valid: jax.Array,
     lanes: int,
     at_final: jax.Array | None = None,
+    radius: float = 1.0,
 ) -> tuple[jax.Array, jax.Array]:
     """For every valid candidate c: does the policy, restored at ``starts[start_of[c]]`` pursuing
     ``goals[c]``, hit it within ``horizon_of[c]`` steps (where ``at_final[c]``: is it at the goal
@@ -121,7 +130,7 @@ def replay_queue(
     def body(q: _Queue) -> _Queue:
         s = step_batch(env, q.state, policy.act(pstate, q.state.obs, q.state.desired_goal))
         steps = q.steps + 1
-        hit = s.success & ~s.invalid
+        hit = within(env, s.achieved_goal, s.desired_goal, radius) & ~s.invalid
         done = q.active & ((hit & ~at_final[q.cand]) | (steps >= horizon_of[q.cand]))
         reached = q.reached.at[jnp.where(done, q.cand, m)].set(hit)
         # finished lanes take the next candidates in queue order
@@ -152,12 +161,18 @@ def select(
     use_select: bool,
     lanes: float = 1.0,
     hold: bool = False,
+    settle: bool = False,
+    radius: float = 1.0,
 ) -> Candidates:
     """``max_horizon`` fixes the shapes; ``horizon`` (traced, <= max_horizon) masks the candidates
     of larger h, so runs with different H share one compiled program. ``use_select=False`` is the
     ablation: every valid pair is stored, nothing is replayed. ``lanes`` sets the width of the
     replay batch as a fraction of the T x N explored steps; it changes speed, never a verdict.
-    ``hold`` adds the held-goal candidates (module docstring), one per explored step, at h = H."""
+    ``hold`` adds the held-goal candidates (module docstring), one per explored step, at h = H.
+    ``settle`` (with ``hold``) keeps only moved candidates whose object then stays at g' for the next
+    H steps (or to the episode's end), and judges every candidate at its final step: the explored
+    actions are imitated where they leave the object at g' and the policy does not. ``radius`` scales
+    the task's success threshold for every test here (``within``)."""
     T, H = env.episode_length, max_horizon
     n = traj.actions.shape[1]
     hs = jnp.arange(1, H + 1)
@@ -165,9 +180,14 @@ def select(
     later = jnp.minimum(t[None, :] + hs[:, None], T)  # [H, T] index of s_{t+h}, clamped
     goal = traj.achieved[later]  # [H, T, N, G]
     real = (t[None, :] + hs[:, None] <= T)[..., None] & ~traj.invalid[:T][None] & ~traj.invalid[later]
-    achieved_at_t = env.success(traj.achieved[:T][None], goal)
+    achieved_at_t = within(env, traj.achieved[:T][None], goal, radius)
     moved = real & ~achieved_at_t & (hs <= horizon)[:, None, None]  # Algorithm 2's candidates
     held = real & achieved_at_t & (hs == horizon)[:, None, None] & hold
+    if settle:
+        after = jnp.minimum(later[..., None] + jnp.arange(1, H + 1), T)  # [H, T, H] the steps after t + h
+        stays = jnp.all(within(env, traj.achieved[after], goal[:, :, None], radius), axis=2)
+        moved = moved & stays
+    at_final = (held | (moved & settle)).reshape(-1)
     valid, held = (moved | held).reshape(-1), held.reshape(-1)
     goal = goal.reshape(H * T * n, -1)
     if use_select:
@@ -183,7 +203,8 @@ def select(
             flat // (T * n) + 1,
             valid,
             num_lanes(T, n, lanes),
-            at_final=held,
+            at_final=at_final,
+            radius=radius,
         )
         accept = valid & ~reached
     else:

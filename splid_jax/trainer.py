@@ -87,7 +87,9 @@ class Trainer:
                 self.horizon_at(ts.iteration, hyper),
                 cfg.select,
                 cfg.select_lanes,
-                hold=cfg.relabel == "hold",
+                hold=cfg.relabel in ("hold", "settle"),
+                settle=cfg.relabel == "settle",
+                radius=cfg.select_radius,
             )
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
         pstate = policy.update_normaliser(ts.policy, traj.states.obs, traj.achieved[:-1], ~traj.invalid[:-1])

@@ -29,15 +29,20 @@ def policy(env):
 
 @pytest.fixture(scope="module")
 def run_select(env, policy):
-    """``run_select(pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False)``: SELECT, jitted
-    once per (use_select, lanes, hold)."""
+    """``run_select(pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False,
+    radius=1.0)``: SELECT, jitted once per setting."""
 
     @functools.cache
-    def jitted(use_select, lanes, hold):
-        return jax.jit(lambda ps, tr, hz: select(env, policy, ps, tr, H, hz, use_select, lanes, hold=hold))
+    def jitted(*static):
+        use_select, lanes, hold, settle, radius = static
+        return jax.jit(
+            lambda ps, tr, hz: select(
+                env, policy, ps, tr, H, hz, use_select, lanes, hold=hold, settle=settle, radius=radius
+            )
+        )
 
-    def run(pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False):
-        return jitted(use_select, lanes, hold)(pstate, traj, jnp.int32(horizon))
+    def run(pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False, radius=1.0):
+        return jitted(use_select, lanes, hold, settle, radius)(pstate, traj, jnp.int32(horizon))
 
     return run
 
@@ -183,3 +188,25 @@ def test_held_goals_are_kept_where_the_policy_leaves_them_and_judged_at_the_fina
     assert bool(policy_reaches(env, policy, drift, there, goal, H)) and not bool(
         policy_reaches(env, policy, drift, there, goal, H, at_final=True)
     )
+
+
+def test_settle_keeps_moved_goals_where_the_object_then_stays_and_radius_scales_the_threshold(
+    env, policy, run_select
+):
+    """0.3 per step in y: a goal is 'reached' once the point moved more than the radius (1.0: h >= 4;
+    0.5: h >= 2). ``settle`` keeps a moved goal only where the point then stays within the radius of
+    it for H steps or to the episode's end (0.3 per step leaves 1.0 after 4 steps: only t + h >= T - 3),
+    and replays every kept candidate its full h (verdict at the final step)."""
+    traj = scripted_trajectory(env, [[0.0, 0.3]])
+    drift = constant_policy(policy, [1.0, 0.0])  # never at a goal up the y axis
+    hs, ts = np.arange(1, H + 1)[:, None], np.arange(T)[None, :]
+    paper = (hs >= 4) & (ts + hs <= T)
+    np.testing.assert_array_equal(env_of(run_select(drift, traj).valid)[..., 0], paper)
+    near = env_of(run_select(drift, traj, radius=0.5).valid)[..., 0]
+    np.testing.assert_array_equal(near, (hs >= 2) & (ts + hs <= T))
+    settled = run_select(drift, traj, hold=True, settle=True)
+    want = paper & (ts + hs >= T - 3)
+    np.testing.assert_array_equal(env_of(settled.valid)[..., 0], want)
+    np.testing.assert_array_equal(settled.accept, settled.valid)
+    # every kept candidate, moved or held (the standing-still envs' h = H ones), runs its full h
+    assert int(settled.replay_steps) == int((hs[..., None] * env_of(settled.valid)).sum()) > int((hs * want).sum())

@@ -1,0 +1,169 @@
+"""Why a policy reaches the goal but does not stay, and what holds it there: seeds of one setting as
+one vmapped program, learning curves on both success measures, then per-step traces of the final
+policies' evaluation episodes (distance to goal, share at the goal at each step, the object's speed
+at the first hit) and the SELECT candidates' make-up.
+
+    python experiments/final_step.py --env push --seeds 5 --iterations 80 \
+        --set relabel=paper --set relabel=hold --out experiments/results/2026-11-23/final-step-push
+
+Each ``--set`` is one arm (comma-separated TrainConfig fields); arms run one after the other with the
+same seeds. Writes ``ARM.json`` per arm and ``traces.png`` comparing them."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import json
+import os
+import time
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+import envs
+from envs.base import step_batch
+from splid_jax.config import TrainConfig
+from splid_jax.her import HER, HerConfig
+from splid_jax.trainer import Trainer
+
+
+def traces(env, trainer: Trainer, pstate, key, episodes: int) -> dict:
+    """Per-step distance to the goal and success of the deterministic policy, and the achieved goal's
+    speed (m/s) on the step of its first hit."""
+    start = jax.vmap(env.reset)(jax.random.split(key, episodes))
+
+    def one(state, _):
+        nxt = step_batch(env, state, trainer.policy.act(pstate, state.obs, state.desired_goal))
+        dist = jnp.linalg.norm(nxt.achieved_goal - nxt.desired_goal, axis=-1)
+        speed = jnp.linalg.norm(nxt.achieved_goal - state.achieved_goal, axis=-1) / getattr(env, "dt", 1.0)
+        return nxt, (dist, nxt.success & ~nxt.invalid, speed)
+
+    _, (dist, succ, speed) = jax.lax.scan(one, start, None, length=env.episode_length)
+    first = jnp.argmax(succ, axis=0)
+    hit = jnp.any(succ, axis=0)
+    speed_at_hit = jnp.where(hit, jnp.take_along_axis(speed, first[None], axis=0)[0], jnp.nan)
+    stays = hit & jnp.all(jnp.where(jnp.arange(env.episode_length)[:, None] >= first[None], succ, True), axis=0)
+    return {
+        "success_per_step": jnp.mean(succ, axis=1),
+        "distance_median_per_step": jnp.median(dist, axis=1),
+        "speed_at_first_hit_median": jnp.nanmedian(speed_at_hit),
+        "hit": jnp.mean(hit),
+        "hit_and_stayed": jnp.mean(stays),
+    }
+
+
+def run_arm(env_name: str, seeds: int, base: dict, fields: dict, trace_episodes: int) -> dict:
+    merged = {**base, **fields}
+    her = {k[4:]: v for k, v in merged.items() if k.startswith("her_")}  # HerConfig fields, e.g. her_batch_size
+    cfg = TrainConfig(env=env_name, **{k: v for k, v in merged.items() if not k.startswith("her_")})
+    with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
+        env = envs.make(cfg.env, **cfg.env_overrides())
+    trainer = HER(env, cfg, HerConfig(**her)) if cfg.algo == "her" else Trainer(env, cfg)
+    keys = jnp.stack([jax.random.PRNGKey(1000 + s) for s in range(seeds)])
+    state = jax.jit(jax.vmap(trainer.init))(keys)
+    hyper = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (seeds,)), trainer.hyper())
+    chunk = jax.jit(jax.vmap(trainer.chunk))
+    t0 = time.perf_counter()
+    compiled = chunk.lower(state, hyper).compile()
+    compile_s = time.perf_counter() - t0
+    curve, t0 = [], time.perf_counter()
+    for it in range(cfg.eval_every, cfg.iterations + 1, cfg.eval_every):
+        state, m = compiled(state, hyper)
+        m = jax.device_get(m)
+        curve.append(
+            {
+                "iteration": it,
+                "episodes": it * cfg.num_envs,
+                "wall_s": time.perf_counter() - t0,
+                **{k: np.asarray(v).tolist() for k, v in m.items() if k != "select_steps"},
+            }
+        )
+        last = curve[-1]
+        print(
+            f"{fields} it {it:4d} ep {last['episodes']:6d} any {np.mean(last['eval_success']):.3f} "
+            f"final {np.mean(last['eval_success_final']):.3f} wall {last['wall_s']:.1f}s",
+            flush=True,
+        )
+    tr = jax.jit(jax.vmap(lambda ps, k: traces(env, trainer, ps, k, trace_episodes)))(
+        state.policy, jax.random.split(jax.random.PRNGKey(7), seeds)
+    )
+    return {
+        "env": env_name,
+        "fields": fields,
+        "config": cfg.to_json(),
+        "seeds": seeds,
+        "device": jax.devices()[0].device_kind,
+        "date": time.strftime("%Y-%m-%d"),
+        "compile_s": compile_s,
+        "curve": curve,
+        "traces": {k: np.asarray(v).tolist() for k, v in jax.device_get(tr).items()},
+    }
+
+
+def parse_set(text: str) -> dict:
+    return {k: v for k, v in envs.parse_overrides(text, "set").items()}
+
+
+def figure(results: list[dict], out: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4))
+    for r in results:
+        label = ",".join(f"{k}={v}" for k, v in r["fields"].items()) or "default"
+        ep = [c["episodes"] for c in r["curve"]]
+        for key, style, name in (("eval_success", "-", "any step"), ("eval_success_final", "--", "final step")):
+            y = np.array([c[key] for c in r["curve"]])
+            mean, sem = y.mean(1), y.std(1, ddof=1) / np.sqrt(y.shape[1]) if y.shape[1] > 1 else 0 * y.mean(1)
+            ax[0].plot(ep, mean, style, label=f"{label} ({name})")
+            ax[0].fill_between(ep, mean - sem, mean + sem, alpha=0.2)
+        steps = np.arange(1, len(r["traces"]["success_per_step"][0]) + 1)
+        ax[1].plot(steps, np.mean(r["traces"]["success_per_step"], 0), label=label)
+        ax[2].plot(steps, np.mean(r["traces"]["distance_median_per_step"], 0), label=label)
+    ax[0].set(xlabel="exploration episodes", ylabel="eval success (mean ± s.e.)", title="learning curves")
+    ax[1].set(xlabel="episode step", ylabel="share of episodes at the goal", title="final policies: at the goal")
+    ax[2].set(xlabel="episode step", ylabel="median distance to goal (m)", title="final policies: distance to goal")
+    for a in ax:
+        a.legend(fontsize=7)
+        a.grid(alpha=0.3)
+    fig.suptitle(f"{results[0]['env']}: {results[0]['seeds']} seeds, {results[0]['device']}, {results[0]['date']}")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
+    p.add_argument("--env", default="push")
+    p.add_argument("--seeds", type=int, default=5)
+    p.add_argument("--iterations", type=int, default=None)
+    p.add_argument("--set", action="append", default=[], help="one arm: KEY=VALUE[,KEY=VALUE]")
+    p.add_argument("--base", default="", help="fields shared by every arm: KEY=VALUE[,KEY=VALUE]")
+    p.add_argument("--trace-episodes", type=int, default=500)
+    p.add_argument("--out", required=True)
+    a = p.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    base = parse_set(a.base)
+    if a.iterations:
+        base["iterations"] = a.iterations
+    results = []
+    for spec in a.set or [""]:
+        r = run_arm(a.env, a.seeds, base, parse_set(spec), a.trace_episodes)
+        name = "-".join(f"{k}{v}" for k, v in r["fields"].items()) or "default"
+        with open(os.path.join(a.out, f"{a.env}-{name}.json"), "w") as fh:
+            json.dump(r, fh)
+        results.append(r)
+        t = r["traces"]
+        print(
+            f"{r['fields']}: hit {np.mean(t['hit']):.3f} stayed {np.mean(t['hit_and_stayed']):.3f} "
+            f"speed at first hit {np.mean(t['speed_at_first_hit_median']):.3f} m/s; compile {r['compile_s']:.1f}s",
+            flush=True,
+        )
+    figure(results, os.path.join(a.out, f"{a.env}-traces.png"))
+
+
+if __name__ == "__main__":
+    main()
