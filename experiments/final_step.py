@@ -6,8 +6,9 @@ at the first hit) and the SELECT candidates' make-up.
     python experiments/final_step.py --env push --seeds 5 --iterations 80 \
         --set relabel=paper --set relabel=hold --out experiments/results/2026-11-23/final-step-push
 
-Each ``--set`` is one arm (comma-separated TrainConfig fields); arms run one after the other with the
-same seeds. Writes ``ARM.json`` per arm and ``traces.png`` comparing them."""
+Each ``--set`` is one arm (comma-separated TrainConfig fields, HerConfig fields as her_FIELD); arms run
+one after the other with the same seeds. Writes ``ARM.json`` per arm and ``ENV-traces.png`` comparing
+them; ``--replot ARM.json...`` redraws that figure from saved arms."""
 
 from __future__ import annotations
 
@@ -113,17 +114,18 @@ def figure(results: list[dict], out: str) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(1, 3, figsize=(15, 4))
-    for r in results:
-        label = ",".join(f"{k}={v}" for k, v in r["fields"].items()) or "default"
+    for i, r in enumerate(results):
+        color = f"C{i}"
+        label = ",".join(f"{k}={v}" for k, v in r["fields"].items()) or r["config"].get("algo", "default")
         ep = [c["episodes"] for c in r["curve"]]
         for key, style, name in (("eval_success", "-", "any step"), ("eval_success_final", "--", "final step")):
             y = np.array([c[key] for c in r["curve"]])
             mean, sem = y.mean(1), y.std(1, ddof=1) / np.sqrt(y.shape[1]) if y.shape[1] > 1 else 0 * y.mean(1)
-            ax[0].plot(ep, mean, style, label=f"{label} ({name})")
-            ax[0].fill_between(ep, mean - sem, mean + sem, alpha=0.2)
+            ax[0].plot(ep, mean, style, color=color, label=f"{label} ({name})")
+            ax[0].fill_between(ep, mean - sem, mean + sem, color=color, alpha=0.2)
         steps = np.arange(1, len(r["traces"]["success_per_step"][0]) + 1)
-        ax[1].plot(steps, np.mean(r["traces"]["success_per_step"], 0), label=label)
-        ax[2].plot(steps, np.mean(r["traces"]["distance_median_per_step"], 0), label=label)
+        ax[1].plot(steps, np.mean(r["traces"]["success_per_step"], 0), color=color, label=label)
+        ax[2].plot(steps, np.mean(r["traces"]["distance_median_per_step"], 0), color=color, label=label)
     ax[0].set(xlabel="exploration episodes", ylabel="eval success (mean ± s.e.)", title="learning curves")
     ax[1].set(xlabel="episode step", ylabel="share of episodes at the goal", title="final policies: at the goal")
     ax[2].set(xlabel="episode step", ylabel="median distance to goal (m)", title="final policies: distance to goal")
@@ -144,7 +146,15 @@ def main() -> None:
     p.add_argument("--base", default="", help="fields shared by every arm: KEY=VALUE[,KEY=VALUE]")
     p.add_argument("--trace-episodes", type=int, default=500)
     p.add_argument("--out", required=True)
+    p.add_argument("--replot", nargs="+", metavar="JSON", help="draw OUT/ENV-traces.png from saved arms, no training")
     a = p.parse_args()
+    if a.replot:
+        results = []
+        for path in a.replot:
+            with open(path) as fh:
+                results.append(json.load(fh))
+        figure(results, os.path.join(a.out, f"{a.env}-traces.png"))
+        return
     os.makedirs(a.out, exist_ok=True)
     base = parse_set(a.base)
     if a.iterations:
