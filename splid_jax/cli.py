@@ -11,6 +11,7 @@ import dataclasses
 import io
 import os
 import signal
+import sys
 
 
 def quiet_interrupts() -> None:
@@ -158,3 +159,13 @@ def use_compile_cache(path: str) -> None:
 
     if path:  # programs that compile in under a second are not kept (JAX's default threshold)
         jax.config.update("jax_compilation_cache_dir", path)
+
+
+def exit_with(code: int) -> None:
+    """Exit with ``code``; after a signal (130, 143) at once: the chunk or compilation the signal cut
+    short may still run in a worker thread."""
+    if code in (130, 143):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    raise SystemExit(code)

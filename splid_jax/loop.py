@@ -151,23 +151,7 @@ class _Signals:
 
 
 def read_metrics(path: str) -> list[dict]:
-    """The records of a metrics.jsonl; a torn last line (the writer was killed mid-line) is dropped."""
-    if not os.path.exists(path):
-        return []
-    with open(path) as fh:
-        text = fh.read()
-    lines = text.splitlines()
-    records = []
-    for n, line in enumerate(lines, 1):
-        if not line.strip():
-            continue
-        try:
-            records.append(json.loads(line))
-        except json.JSONDecodeError as e:
-            if n == len(lines) and not text.endswith("\n"):
-                break
-            raise checkpoint.CheckpointError(f"{path}:{n}: not a JSON record ({e.msg})") from e
-    return records
+    return progress.read_metrics(path, checkpoint.CheckpointError)
 
 
 def _write_atomic(path: str, text: str) -> None:

@@ -20,6 +20,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg
 
+from splid_jax import progress
+
 DESCRIPTION = (
     "Learning curves of one or more runs: evaluation success (solid: at any step, dashed: at the final step) "
     "and return, against episodes, env steps and wall-clock seconds."
@@ -63,19 +65,7 @@ def load_run(run_dir: str) -> Run:
     path = os.path.join(run_dir, "metrics.jsonl")
     if not os.path.isfile(path):
         raise PlotError(f"{path}: no metrics file")
-    with open(path) as fh:
-        text = fh.read()
-    lines = text.splitlines()
-    records = []
-    for n, line in enumerate(lines, 1):
-        if not line.strip():
-            continue
-        try:
-            records.append(json.loads(line))
-        except json.JSONDecodeError as e:
-            if n == len(lines) and not text.endswith("\n"):
-                break  # the writer was stopped mid-line; every line before it is whole
-            raise PlotError(f"{path}:{n}: not a JSON object ({e.msg})") from e
+    records = progress.read_metrics(path, PlotError)
     if not records:
         raise PlotError(f"{path}: no evaluation records yet")
     for n, rec in enumerate(records, 1):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+import os
 import sys
 
 
@@ -56,3 +58,24 @@ def sweep_line(recs: list[dict], total_iterations: int) -> str:
 def show(text: str, quiet: bool = False) -> None:
     if not quiet:
         print(text, file=sys.stdout, flush=True)
+
+
+def read_metrics(path: str, error: type[Exception]) -> list[dict]:
+    """The records of a metrics.jsonl; a torn last line (the writer was killed mid-line) is dropped,
+    any other bad line raises ``error`` naming the file and line."""
+    if not os.path.exists(path):
+        return []
+    with open(path) as fh:
+        text = fh.read()
+    lines = text.splitlines()
+    records = []
+    for n, line in enumerate(lines, 1):
+        if not line.strip():
+            continue
+        try:
+            records.append(json.loads(line))
+        except json.JSONDecodeError as e:
+            if n == len(lines) and not text.endswith("\n"):
+                break
+            raise error(f"{path}:{n}: not a JSON record ({e.msg})") from e
+    return records

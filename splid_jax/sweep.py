@@ -8,7 +8,7 @@ under RUN_DIR, so ``--resume RUN_DIR`` continues a sweep as it continues a run."
 
 from __future__ import annotations
 
-from splid_jax.cli import quiet_interrupts
+from splid_jax.cli import exit_with, quiet_interrupts
 
 if __name__ == "__main__":  # a signal while JAX loads ends the process with one line, no traceback
     quiet_interrupts()
@@ -169,9 +169,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    code = main()
-    if code in (130, 143):  # the chunk or compilation the signal cut short may still run in a thread
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(code)
-    raise SystemExit(code)
+    exit_with(main())

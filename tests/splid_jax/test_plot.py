@@ -98,7 +98,7 @@ def test_truncated_last_line_is_ignored(tmp_path):
         (lambda root: root.joinpath("empty_dir").mkdir() or root / "empty_dir", "no metrics file"),
         (lambda root: _with_metrics(root, ""), "no evaluation records"),
         (lambda root: _with_metrics(root, '{"iteration": 1}\n'), "record 1 lacks episodes"),
-        (lambda root: _with_metrics(root, "garbage\n{}\n"), "metrics.jsonl:1: not a JSON object"),
+        (lambda root: _with_metrics(root, "garbage\n{}\n"), "metrics.jsonl:1: not a JSON record"),
     ],
     ids=["missing-dir", "missing-metrics", "empty-metrics", "missing-key", "bad-line"],
 )
