@@ -91,8 +91,6 @@ class _FetchTask(GoalEnv):
     table: str = "plane"  # the table's collision shape: its top face as a plane, or the reference's box
     finger: str = "box"  # the closed finger block's collision shape (Push: box or capsule, see models.py)
     cholesky: str = "unrolled"  # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
-    drive_omega: float = models.DRIVE_OMEGA  # rad/s: natural frequency of the gripper's xyz drive
-    drive_damping_ratio: float = 1.0  # of the same drive (models.mjcf)
     workspace: str = "arm"  # where the gripper target may go: the box and the reference arm's reach, or the box
     drive: str = "pd"  # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
 
@@ -121,12 +119,6 @@ class _FetchTask(GoalEnv):
         check(self.workspace in spaces, f"{n}.workspace", self.workspace, "one of " + ", ".join(spaces))
         check(self.drive in models.DRIVES, f"{n}.drive", self.drive, "one of " + ", ".join(models.DRIVES))
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
-        check(10 <= self.drive_omega <= 200, f"{n}.drive_omega", self.drive_omega, "in [10, 200] rad/s")
-        check(0.5 <= self.drive_damping_ratio <= 3, f"{n}.drive_damping_ratio", self.drive_damping_ratio, "in [0.5, 3]")
-        for field in ("drive_omega", "drive_damping_ratio"):  # the PD drive's gains; the weld law has its own
-            default = _FetchTask.__dataclass_fields__[field].default
-            check(self.drive == "pd" or getattr(self, field) == default, f"{n}.{field}", getattr(self, field),
-                  f"{default} (the default) with drive='weld': it sets the PD drive")
         check(
             isinstance(self.max_episode_steps, int) and self.max_episode_steps >= 1,
             f"{n}.max_episode_steps",
@@ -170,8 +162,6 @@ class _FetchTask(GoalEnv):
             ls_iterations=int(self.ls_iterations),
             table=str(self.table),
             finger=str(self.finger),
-            drive_omega=float(self.drive_omega),
-            drive_damping_ratio=float(self.drive_damping_ratio),
             drive=str(self.drive),
         )
 

@@ -127,8 +127,6 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("push", "iterations", 0),
         ("reach", "max_episode_steps", 0),
         ("push", "cholesky", "lapack"),
-        ("slide", "drive_omega", 0.0),
-        ("push", "drive_damping_ratio", 10.0),
         ("slide", "workspace", "sphere"),
         ("push", "drive", "mocap"),
     ],
@@ -136,12 +134,6 @@ def test_reset_samples_stay_in_their_ranges(name):
 def test_bad_overrides_fail_naming_the_field(name, field, value):
     with pytest.raises(InvalidConfig, match=rf"{name}\.{field}"):
         envs.make(name, **{field: value})
-
-
-def test_pd_gains_with_the_weld_drive_fail_naming_the_gain():
-    with pytest.raises(InvalidConfig, match=r"slide\.drive_omega"):
-        envs.make("slide", drive="weld", drive_omega=55.0)
-    assert envs.make("slide", drive="pd", drive_omega=55.0).drive_omega == 55.0
 
 
 def _target_after(env, grip_world, action):
