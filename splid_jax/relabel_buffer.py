@@ -5,6 +5,7 @@ pairs SELECT accepted."""
 
 from __future__ import annotations
 
+import chex
 import jax
 import jax.numpy as jnp
 from flax import struct
@@ -36,6 +37,11 @@ def init(capacity: int, obs_size: int, goal_size: int, action_size: int) -> Buff
 def insert(buf: Buffer, obs: jax.Array, goal: jax.Array, action: jax.Array, mask: jax.Array) -> Buffer:
     """Append the rows where ``mask`` holds, in order; past capacity the oldest are overwritten.
     If one batch holds more than the capacity, only its newest ``capacity`` rows are kept."""
+    chex.assert_rank([obs, goal, action, mask], [2, 2, 2, 1])  # at trace time: a wrong layout fails here
+    chex.assert_equal_shape_prefix([obs, goal, action, mask], 1)
+    chex.assert_equal_shape_suffix([obs, buf.obs], 1)
+    chex.assert_equal_shape_suffix([goal, buf.goal], 1)
+    chex.assert_equal_shape_suffix([action, buf.action], 1)
     cap = buf.capacity
     mask = mask.astype(bool)
     n = jnp.sum(mask, dtype=jnp.int32)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import chex
 import jax
 import jax.numpy as jnp
 
@@ -210,4 +211,6 @@ def select(
     else:
         accept, steps = valid, jnp.int32(0)
     tile = lambda x: jnp.broadcast_to(x[None], (H,) + x.shape).reshape((H * T * n,) + x.shape[2:])  # noqa: E731
-    return Candidates(tile(traj.states.obs), goal, tile(traj.actions), valid, accept, held, steps)
+    out = Candidates(tile(traj.states.obs), goal, tile(traj.actions), valid, accept, held, steps)
+    chex.assert_shape([out.valid, out.accept, out.held], (num_candidates(T, H, n),))
+    return out
