@@ -113,6 +113,8 @@ class TrainConfig:
         check(self.gcsl_relabel in ("final", "future"), "gcsl_relabel", self.gcsl_relabel, "final or future")
         check(0 < self.select_radius <= 1, "select_radius", self.select_radius, "in (0, 1]")
         check(self.pchid_every >= 0, "pchid_every", self.pchid_every, "an integer >= 0")
+        if self.algo == "pchid" and self.pchid_every == 0:  # resolved once, so a resume keeps the schedule
+            object.__setattr__(self, "pchid_every", max(1, self.iterations // (2 * self.horizon)))
         check(self.sigma >= 0, "sigma", self.sigma, ">= 0")
         check(self.horizon >= 1, "horizon", self.horizon, "an integer >= 1 (and < the episode length)")
         check(0 < self.select_lanes <= 1, "select_lanes", self.select_lanes, "in (0, 1]")

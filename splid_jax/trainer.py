@@ -48,7 +48,7 @@ class Trainer:
         cfg.check_env(env)
         self.env, self.cfg, self.name = env, cfg, cfg.algo
         self.max_horizon = cfg.horizon  # shapes; a sweep's members mask larger h through Hyper.horizon
-        self.pchid_every = cfg.pchid_every or max(1, cfg.iterations // (2 * cfg.horizon))
+        self.pchid_every = max(1, cfg.pchid_every)  # TrainConfig resolves 0 for pchid
         self.policy = make_policy(env.obs_size, env.goal_size, env.action_size, cfg.hidden, cfg.normalise)
         self.optimiser = optax.adam(cfg.learning_rate)
 

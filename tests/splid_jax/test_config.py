@@ -34,3 +34,11 @@ def test_every_float_field_must_be_finite(field, value):
 def test_every_field_has_help():
     for f in dataclasses.fields(TrainConfig):
         assert f.metadata.get("help"), f.name
+
+
+def test_pchid_schedule_is_resolved_once_so_a_longer_resume_keeps_it():
+    cfg = TrainConfig(env="point", algo="pchid", iterations=40, horizon=4, eval_every=5)
+    assert cfg.pchid_every == 5  # H reached half-way: 40 // (2 * 4)
+    resumed = TrainConfig(**{**cfg.to_json(), "hidden": tuple(cfg.hidden), "iterations": 80})
+    assert resumed.pchid_every == 5
+    assert TrainConfig(env="point", iterations=40).pchid_every == 0  # other learners leave it unset
