@@ -15,6 +15,7 @@ _REGISTRY = {
     "push": "envs.fetch.tasks:Push",
     "slide": "envs.fetch.tasks:Slide",
     "pick_and_place": "envs.fetch.tasks:PickAndPlace",
+    "reacher": "envs.reacher:Reacher",
 }
 
 

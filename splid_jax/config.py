@@ -268,6 +268,7 @@ TASK_DEFAULTS: dict[str, dict[str, Any]] = {
     },
     "slide": {**_FETCH, "iterations": 50, "num_envs": 1024},
     "pick_and_place": {**_FETCH, "iterations": 50, "num_envs": 1024},
+    "reacher": {**_POINT, "iterations": 40},
 }
 # A learner's own defaults per task, taken before TASK_DEFAULTS for fields left at None. HER on the
 # Fetch tasks runs as OpenAI Baselines: a cycle explores 2 episodes on each of 8 workers (num_envs 16,
