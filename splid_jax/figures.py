@@ -211,7 +211,10 @@ def plan(
         probe.check_env(env)
         per_iteration = loop.make_algorithm(probe, env).counters(1, 0)["episodes"]
         chunks = max(1, math.floor(budget / (per_iteration * probe.eval_every) + 0.5))  # nearest, half up
-        base = dataclasses.replace(probe, iterations=chunks * probe.eval_every)
+        # pchid_every left at 0 is resolved again, so PCHID's schedule follows the figure's iterations
+        base = dataclasses.replace(
+            probe, iterations=chunks * probe.eval_every, pchid_every=fields.get("pchid_every", 0)
+        )
         grid = [(s, v) for v in (values if spec.vary else (None,)) for s in range(seeds)]
         lanes = tuple(
             dataclasses.replace(
@@ -224,7 +227,7 @@ def plan(
         )
         for lane in lanes:
             lane.check_env(env)
-        loop.make_algorithm(base, env)  # the run's own settings (PCHID's schedule follows the iterations)
+        loop.make_algorithm(base, env)  # the run's own settings
         plans.append(Plan(name, base, lanes, per_iteration))
     return plans
 

@@ -205,3 +205,11 @@ def test_fig4_draws_one_series_per_h(tmp_path):
     assert sorted({r["horizon"] for r in table}) == ["2", "8"]
     assert all(r["seeds"] == "2" for r in table)
     assert float([r for r in table if r["horizon"] == "8"][-1]["eval_success_mean"]) == pytest.approx(1.0)
+
+
+def test_pchid_reaches_its_full_horizon_half_way_through_the_figure_run(tmp_path):
+    spec = figures.SPECS["fig3"]
+    sets = figures.parse_sets(["num_envs=16"], ("pchid",))
+    (p,) = figures.plan(spec, "point", ("pchid",), 1, 16 * 40 * 4, sets, str(tmp_path))
+    assert p.base.pchid_every == max(1, p.base.iterations // (2 * p.base.horizon))
+    assert all(lane.pchid_every == p.base.pchid_every for lane in p.lanes)
