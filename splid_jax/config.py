@@ -16,6 +16,10 @@ def _f(default, help: str, **kw):
     return dataclasses.field(default=default, metadata={"help": help, **kw})
 
 
+# Keys a run's config.json holds beside the fields: where it ran, not how to run it.
+PROVENANCE = ("devices",)
+
+
 @dataclasses.dataclass(frozen=True)
 class TrainConfig:
     env: str = _f("point", "task: " + ", ".join(envs.names()))
@@ -72,6 +76,11 @@ class TrainConfig:
     eval_every: int = _f(None, "iterations per compiled chunk; evaluation, logging and checkpoints come between")
     eval_episodes: int = _f(None, "episodes of the deterministic policy per evaluation")
     checkpoint_every: int = _f(1, "chunks between checkpoints (0: only at the end)")
+    num_devices: int = _f(
+        1,
+        "devices to split the work across: a sweep's members, or a run's envs (splid, gcsl, pchid); "
+        "0: every device this process sees that the count divides. CPU devices only for now",
+    )
     run_dir: str | None = _f(None, "directory for config.json, metrics.jsonl and checkpoints (default runs/ENV-sSEED)")
     env_options: str = _f(
         "", "task fields as KEY=VALUE[,KEY=VALUE...], e.g. finger=capsule or substeps=20,timestep=0.002"
@@ -113,6 +122,7 @@ class TrainConfig:
         check(self.gcsl_relabel in ("final", "future"), "gcsl_relabel", self.gcsl_relabel, "final or future")
         check(0 < self.select_radius <= 1, "select_radius", self.select_radius, "in (0, 1]")
         check(self.pchid_every >= 0, "pchid_every", self.pchid_every, "an integer >= 0")
+        check(self.num_devices >= 0, "num_devices", self.num_devices, "an integer >= 0 (0: every device)")
         if self.algo == "pchid" and self.pchid_every == 0:  # resolved once, so a resume keeps the schedule
             object.__setattr__(self, "pchid_every", max(1, self.iterations // (2 * self.horizon)))
         check(self.sigma >= 0, "sigma", self.sigma, ">= 0")
@@ -164,6 +174,11 @@ class TrainConfig:
 
     def to_json(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
+
+    @classmethod
+    def from_json(cls, saved: dict[str, Any], **changes) -> TrainConfig:
+        """A config from a run's config.json, which also records the hardware it ran on."""
+        return cls(**{**{k: v for k, v in saved.items() if k not in PROVENANCE}, **changes})
 
 
 def parse_options(cls, text: str, field: str, prefix: str):
@@ -269,6 +284,7 @@ TASK_DEFAULTS: dict[str, dict[str, Any]] = {
     "slide": {**_FETCH, "iterations": 50, "num_envs": 1024},
     "pick_and_place": {**_FETCH, "iterations": 50, "num_envs": 1024},
     "reacher": {**_POINT, "iterations": 40},
+    "sawyer_door": {**_POINT, "iterations": 40},
 }
 # A learner's own defaults per task, taken before TASK_DEFAULTS for fields left at None. HER on the
 # Fetch tasks runs as OpenAI Baselines: a cycle explores 2 episodes on each of 8 workers (num_envs 16,

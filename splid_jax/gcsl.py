@@ -10,13 +10,13 @@ import jax
 import jax.numpy as jnp
 
 from envs.base import GoalEnv
-from splid_jax.explore import Trajectory
+from splid_jax.explore import Seen
 from splid_jax.select import Candidates
 
 RELABELS = ("final", "future")
 
 
-def relabel(env: GoalEnv, traj: Trajectory, mode: str, key: jax.Array) -> Candidates:
+def relabel(env: GoalEnv, traj: Seen, mode: str, key: jax.Array) -> Candidates:
     """One candidate per explored step, layout [T, N]; every valid one is accepted."""
     T, n = env.episode_length, traj.actions.shape[1]
     t = jnp.arange(T)[:, None]
@@ -32,5 +32,5 @@ def relabel(env: GoalEnv, traj: Trajectory, mode: str, key: jax.Array) -> Candid
     flat = lambda x: x.reshape((T * n,) + x.shape[2:])  # noqa: E731
     valid = flat(valid)
     return Candidates(
-        flat(traj.states.obs), flat(goal), flat(traj.actions), valid, valid, jnp.zeros_like(valid), jnp.int32(0)
+        flat(traj.obs), flat(goal), flat(traj.actions), valid, valid, jnp.zeros_like(valid), jnp.int32(0)
     )

@@ -29,12 +29,12 @@ import numpy as np
 
 import envs
 from envs.base import InvalidConfig
-from splid_jax import checkpoint, progress
+from splid_jax import checkpoint, devices, progress
 from splid_jax.algorithm import EVAL_KEYS, Algorithm
 from splid_jax.config import TrainConfig
 
 # Fields a resumed run must share with its checkpoint; the rest may change on resume.
-MAY_CHANGE_ON_RESUME = frozenset({"iterations", "run_dir", "checkpoint_every"})
+MAY_CHANGE_ON_RESUME = frozenset({"iterations", "run_dir", "checkpoint_every", "num_devices"})
 COUNTER_KEYS = ("iteration", "episodes", "env_steps", "select_steps")
 METRICS = "metrics.jsonl"
 SWEEP = "sweep.json"  # a sweep's config and its members' configs, from which it resumes
@@ -71,12 +71,15 @@ def env_settings(env: envs.GoalEnv) -> dict:
     return json.loads(json.dumps(env.settings()))
 
 
-def make_algorithm(cfg: TrainConfig, env: envs.GoalEnv) -> Algorithm:
-    """The learner ``cfg.algo`` names, built for ``env``."""
-    if cfg.algo in ("splid", "gcsl", "pchid"):
+SPLITS_ENVS = ("splid", "gcsl", "pchid")  # learners whose single run can split its envs across devices
+
+
+def make_algorithm(cfg: TrainConfig, env: envs.GoalEnv, mesh: jax.sharding.Mesh | None = None) -> Algorithm:
+    """The learner ``cfg.algo`` names, built for ``env`` (its envs split across ``mesh``)."""
+    if cfg.algo in SPLITS_ENVS:
         from splid_jax.trainer import Trainer
 
-        return Trainer(env, cfg)
+        return Trainer(env, cfg, mesh)
     if cfg.algo == "her":
         from splid_jax.her import HER
 
@@ -86,6 +89,21 @@ def make_algorithm(cfg: TrainConfig, env: envs.GoalEnv) -> Algorithm:
 
         return ES(env, cfg, cfg.es_config())
     raise InvalidConfig("algo", cfg.algo, "one of splid, gcsl, pchid, her, es")
+
+
+def placement(cfg: TrainConfig, members: int | None, algo: Algorithm | None = None) -> devices.Placement:
+    """The devices a run (``members`` None) or a sweep of ``members`` uses (``cfg.num_devices``)."""
+    if members is not None:
+        return devices.place(cfg.num_devices, members, devices.MEMBERS)
+    if algo is not None:  # built by the caller: its own mesh, if any
+        mesh = getattr(algo, "mesh", None)
+        return devices.Placement(mesh, devices.ENVS) if mesh is not None else devices.place(1, 1, devices.ENVS)
+    if cfg.algo not in SPLITS_ENVS:
+        allowed = f"1 or 0 for a single {cfg.algo} run (a sweep of {cfg.algo} splits its members)"
+        if cfg.num_devices > 1:
+            raise InvalidConfig("num_devices", cfg.num_devices, allowed)
+        return devices.place(1, 1, devices.ENVS)
+    return devices.place(cfg.num_devices, cfg.num_envs, devices.ENVS)
 
 
 def identity(cfg: TrainConfig) -> dict:
@@ -303,14 +321,19 @@ def _get(tree, name):
     return tree[name] if isinstance(tree, dict) else getattr(tree, name)
 
 
-def _canonical(tree, device):
-    """Strongly typed arrays committed to ``device``, whether they come from init or a checkpoint, so
-    the compiled chunk takes a resumed state as it takes a fresh one."""
-    return jax.device_put(jax.tree.map(lambda x: jnp.asarray(x).astype(jnp.asarray(x).dtype), tree), device)
+def _canonical(tree, sharding):
+    """Strongly typed arrays placed as ``sharding`` says, whether they come from init or a checkpoint,
+    so the compiled chunk takes a resumed state as it takes a fresh one."""
+    # made on one device, then placed: XLA:CPU under jaxlib 0.10 can hang in a later program that reads
+    # an array a multi-device jit wrote through out_shardings
+    return jax.device_put(jax.jit(_strong)(tree), sharding)
 
 
-def _abstract(tree, device):
-    sharding = jax.sharding.SingleDeviceSharding(device)
+def _strong(tree):
+    return jax.tree.map(lambda x: jnp.asarray(x).astype(jnp.asarray(x).dtype), tree)
+
+
+def _abstract(tree, sharding):
     return jax.tree.map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=sharding), tree)
 
 
@@ -346,18 +369,22 @@ def run(
     ``members``: the configs of a sweep's members (each its own seed, run_dir and traced settings),
     trained in lock-step as one vmapped program with checkpoints under ``cfg.run_dir``."""
     env = env or make_env(cfg.env, **cfg.env_overrides())
-    algo = algo or make_algorithm(cfg, env)
+    place = placement(cfg, None if members is None else len(members), algo)
+    split_envs = place.axis == devices.ENVS and place.count > 1
+    algo = algo or make_algorithm(cfg, env, place.mesh if split_envs else None)
     with _Signals() as signals:
-        return _Loop(cfg, env, algo, members, signals, quiet).run(resume)
+        return _Loop(cfg, env, algo, members, place, signals, quiet).run(resume)
 
 
 class _Loop:
-    def __init__(self, cfg, env, algo, members, signals: _Signals, quiet: bool):
+    def __init__(self, cfg, env, algo, members, place: devices.Placement, signals: _Signals, quiet: bool):
         self.cfg, self.env, self.algo, self.signals, self.quiet = cfg, env, algo, signals, quiet
         self.stacked = members is not None
         self.lanes = list(members) if self.stacked else [cfg]
-        self.device = jax.devices()[0]
+        self.place = place
+        self.device = place.first
         self.saved_at: int | None = None
+        self.groups: _Groups | None = None
 
     def show(self, text: str) -> None:
         progress.show(text, self.quiet)
@@ -390,33 +417,43 @@ class _Loop:
         keys = [jax.random.PRNGKey(m.seed) for m in self.lanes]
         hypers = [_lane_hyper(algo, cfg, m) for m in self.lanes]
         init, chunk = algo.init, algo.chunk
+        place = self.place
         if self.stacked:
             keys, hyper = jnp.stack(keys), jax.tree.map(lambda *x: jnp.stack(x), *hypers)
             init, chunk = jax.vmap(init), jax.vmap(chunk)
         else:
             keys, hyper = keys[0], hypers[0]
-        hyper = _canonical(hyper, self.device)
-        like = _abstract(jax.eval_shape(init, keys), self.device)
+        split = self.stacked and place.axis == devices.MEMBERS and place.count > 1
+        groups = _Groups(place, len(self.lanes)) if split else None
+        sharding = place.state_sharding() if groups is None else jax.sharding.SingleDeviceSharding(self.device)
+        like = _abstract(jax.eval_shape(init, keys), sharding)  # the whole sweep's, as checkpoints hold it
+        one = like if groups is None else groups.first(like)  # what one compiled program takes
+        hyper = _canonical(hyper, sharding)
         try:
-            traced = self.signals.wait(lambda: jax.jit(chunk).trace(like, _abstract(hyper, self.device)))
+            traced = self.signals.wait(lambda: jax.jit(chunk).trace(one, groups.first(hyper) if groups else hyper))
         except OverflowError as e:  # an index past int32: sizes far beyond any device's memory
             raise DoesNotFit(
                 f"invalid sizes ({_sizes(cfg, len(self.lanes))}): too large for the program's 32-bit indices, "
                 "and for any device's memory"
             ) from e
-        state_bytes = sum(_nbytes(x) for x in jax.tree.leaves(like))
+        state_bytes = sum(_nbytes(x) for x in jax.tree.leaves(one))
         largest = largest_value(traced.jaxpr.jaxpr)
         check_memory(2 * state_bytes + largest, f"state {_gb(state_bytes)} twice, largest intermediate {_gb(largest)}",
                      self.device, cfg, len(self.lanes))  # fmt: skip
 
-        self.show(f"splid_jax: algo={algo.name} env={cfg.env} device={self.device.platform}"
+        on = f"{place.count} devices split by {place.axis}" if place.count > 1 else self.device.platform
+        self.show(f"splid_jax: algo={algo.name} env={cfg.env} device={on}"
                   + (f" members={len(self.lanes)}" if self.stacked else ""))  # fmt: skip
         self.show(f"compiling the training program ({compile_hint(self.env)}; "
                   "less when the compile cache holds it)...")  # fmt: skip
         t0 = time.perf_counter()
         compiled = self.signals.wait(lambda: traced.lower().compile())
-        self.show(f"compiled in {time.perf_counter() - t0:.1f} s")
         analysis = compiled.memory_analysis()
+        if groups is not None:
+            compiled = groups.compile(compiled, lambda dev: jax.jit(chunk).trace(
+                groups.on(one, dev), groups.on(groups.first(hyper), dev)).lower().compile(), self.signals)  # fmt: skip
+            hyper = groups.split(hyper)
+        self.show(f"compiled in {time.perf_counter() - t0:.1f} s")
         if analysis is not None:
             need = analysis.argument_size_in_bytes + analysis.output_size_in_bytes + analysis.temp_size_in_bytes
             check_memory(need - analysis.alias_size_in_bytes, "as compiled", self.device, cfg, len(self.lanes))
@@ -424,16 +461,18 @@ class _Loop:
         if resume:
             state, select_steps, wall_before = self.restore(like)
         else:
-            state = _canonical(self.signals.wait(lambda: jax.jit(init)(keys)), self.device)
+            state = _canonical(self.signals.wait(lambda: jax.jit(init)(keys)), sharding)
+            state = state if groups is None else groups.split(state)
             select_steps, wall_before = [0] * len(self.lanes), 0.0
             for lane in self.lanes:
                 os.makedirs(lane.run_dir, exist_ok=True)
                 _write_atomic(os.path.join(lane.run_dir, METRICS), "")
         for lane in self.lanes:
-            _write_json(os.path.join(lane.run_dir, "config.json"), lane.to_json())
+            _write_json(os.path.join(lane.run_dir, "config.json"), {**lane.to_json(), "devices": place.record()})
         if self.stacked:
             named = [{**m.to_json(), "run_dir": os.path.basename(m.run_dir)} for m in self.lanes]
             _write_json(os.path.join(cfg.run_dir, SWEEP), {"config": cfg.to_json(), "members": named})
+        self.groups = groups
         return self.train(compiled, state, hyper, step or 0, select_steps, wall_before)
 
     def restore(self, like):
@@ -444,13 +483,18 @@ class _Loop:
             kept = [r for r in read_metrics(path) if r["iteration"] <= step]
             _write_atomic(path, "".join(json.dumps(r) + "\n" for r in kept))
         self.show(f"resumed {cfg.run_dir} at iteration {step}")
-        return _canonical(state, self.device), [int(s) for s in meta["select_steps"]], float(meta["wall_s"])
+        if self.stacked and self.place.axis == devices.MEMBERS and self.place.count > 1:
+            state = _Groups(self.place, len(self.lanes)).split(state)
+        else:
+            state = _canonical(state, self.place.state_sharding())
+        return state, [int(s) for s in meta["select_steps"]], float(meta["wall_s"])
 
     def save(self, state, iteration: int, select_steps: list[int], wall_s: float) -> None:
         if self.saved_at == iteration:
             return
         meta = {**self.meta(), "wall_s": wall_s, "select_steps": select_steps}
-        checkpoint.save(self.cfg.run_dir, iteration, state, meta)
+        whole = state if self.groups is None else self.groups.join(state)
+        checkpoint.save(self.cfg.run_dir, iteration, whole, meta)
         self.saved_at = iteration
 
     def train(self, compiled, state, hyper, iteration: int, select_steps: list[int], wall_before: float):
@@ -511,3 +555,49 @@ class _Loop:
             self.save(state, iteration, select_steps, wall())
             raise
         return last
+
+
+class _Groups:
+    """A sweep's members in equal groups, one per device, each group a single-device program (the
+    vmapped chunk as one device runs it). Dispatch is asynchronous, so the devices run at once; a
+    group computes exactly what a sweep of its members computes on one device, and no collective
+    or SPMD partitioning is involved (XLA:GPU failed to compile MJX chunks partitioned by
+    ``shard_map``, and XLA:CPU under jaxlib 0.10 can hang in multi-device programs)."""
+
+    def __init__(self, place: devices.Placement, members: int):
+        self.devices = list(place.mesh.devices.flat)
+        self.size = members // len(self.devices)
+
+    def first(self, tree):
+        return jax.tree.map(lambda x: _slice(x, 0, self.size), tree)
+
+    def on(self, tree, device):
+        sharding = jax.sharding.SingleDeviceSharding(device)
+        return jax.tree.map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=sharding), tree)
+
+    def split(self, tree) -> tuple:
+        host = jax.device_get(tree)
+        return tuple(
+            jax.device_put(jax.tree.map(lambda x, i=i: _slice(x, i * self.size, self.size), host), device)
+            for i, device in enumerate(self.devices)
+        )
+
+    def join(self, groups: tuple):
+        return jax.tree.map(lambda *xs: np.concatenate([np.asarray(x) for x in xs]), *jax.device_get(groups))
+
+    def compile(self, first, compile_on, signals: _Signals):
+        rest = [signals.wait(lambda d=d: compile_on(d)) for d in self.devices[1:]]
+        programs = [first, *rest]
+
+        def run(states: tuple, hypers: tuple):
+            outs = [p(s, h) for p, s, h in zip(programs, states, hypers, strict=True)]  # dispatched at once
+            metrics = jax.tree.map(lambda *m: np.concatenate([np.asarray(x) for x in m]), *[o[1] for o in outs])
+            return tuple(o[0] for o in outs), metrics
+
+        return run
+
+
+def _slice(x, start: int, size: int):
+    if isinstance(x, jax.ShapeDtypeStruct):
+        return jax.ShapeDtypeStruct((size,) + x.shape[1:], x.dtype, sharding=x.sharding)
+    return x[start : start + size]

@@ -37,7 +37,7 @@ def load_config(run_dir: str) -> TrainConfig:
         raise InvalidConfig("run_dir", run_dir, "a run directory holding config.json")
     try:
         with open(path) as fh:
-            return TrainConfig(**{**json.load(fh), "run_dir": run_dir})
+            return TrainConfig.from_json(json.load(fh), run_dir=run_dir)
     except (json.JSONDecodeError, TypeError):
         raise InvalidConfig("run_dir", run_dir, "a run directory whose config.json train wrote") from None
 

@@ -28,7 +28,7 @@ from splid_jax.cli import (  # noqa: E402
     refuse_unread,
     use_compile_cache,
 )
-from splid_jax.config import ALGO_DEFAULTS, TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.config import ALGO_DEFAULTS, PROVENANCE, TASK_DEFAULTS, TrainConfig  # noqa: E402
 from splid_jax.loop import MAY_CHANGE_ON_RESUME, RunStopped, env_settings, make_env  # noqa: E402
 
 __all__ = ["RunStopped", "build_parser", "config_from_cli", "env_settings", "main", "make_env", "run"]
@@ -66,7 +66,7 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
     try:
         with open(path) as fh:
             saved = json.load(fh)
-        unknown = sorted(set(saved) - names) if isinstance(saved, dict) else ["(not an object)"]
+        unknown = sorted(set(saved) - names - set(PROVENANCE)) if isinstance(saved, dict) else ["(not an object)"]
     except (OSError, json.JSONDecodeError):
         unknown = ["(not JSON)"]
     if unknown:
@@ -75,8 +75,7 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
         if k not in MAY_CHANGE_ON_RESUME and v != saved.get(k) and not (isinstance(v, tuple) and list(v) == saved[k]):
             raise InvalidConfig(k, v, f"{saved.get(k)!r} as in the run being resumed (only iterations may change)")
     refuse_unread(given, saved.get("algo", "splid"))
-    saved.update(given, run_dir=ns.resume)
-    return TrainConfig(**saved), True
+    return TrainConfig.from_json(saved, **given, run_dir=ns.resume), True
 
 
 def main(argv: list[str] | None = None) -> int:

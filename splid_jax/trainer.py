@@ -7,15 +7,18 @@ import jax
 import jax.numpy as jnp
 import optax
 from flax import struct
+from jax.sharding import Mesh
+from jax.sharding import PartitionSpec as P
 
 from envs.base import GoalEnv, check
 from splid_jax import gcsl, relabel_buffer
 from splid_jax.bc import bc_epoch
 from splid_jax.config import TrainConfig
+from splid_jax.devices import ENVS
 from splid_jax.evaluate import evaluate
-from splid_jax.explore import explore
+from splid_jax.explore import Seen, draws, rollout
 from splid_jax.networks import PolicyState, make_policy
-from splid_jax.select import select
+from splid_jax.select import Candidates, select
 
 BC_ALGOS = ("splid", "gcsl", "pchid")
 
@@ -41,9 +44,13 @@ class Hyper:
 class Trainer:
     """The behaviour-cloning learners as ``algorithm.Algorithm``s: SPLID (``cfg.algo`` "splid"), PCHID
     (SPLID whose horizon grows from 1 to H) and GCSL (every relabelled pair cloned). Holds what is
-    static (task, network, optimiser, shapes); all state flows through arguments."""
+    static (task, network, optimiser, shapes); all state flows through arguments.
 
-    def __init__(self, env: GoalEnv, cfg: TrainConfig):
+    With a ``mesh`` (one axis, ``devices.ENVS``) each device explores and SELECTs its slice of the
+    envs; the pairs come back in the one-device layout, and insertion, BC and the parameters are
+    replicated, so the run computes what one device would, up to float rounding."""
+
+    def __init__(self, env: GoalEnv, cfg: TrainConfig, mesh: Mesh | None = None):
         check(cfg.algo in BC_ALGOS, "algo", cfg.algo, "one of " + ", ".join(BC_ALGOS) + " for this learner")
         cfg.check_env(env)
         self.env, self.cfg, self.name = env, cfg, cfg.algo
@@ -51,6 +58,11 @@ class Trainer:
         self.pchid_every = max(1, cfg.pchid_every)  # TrainConfig resolves 0 for pchid
         self.policy = make_policy(env.obs_size, env.goal_size, env.action_size, cfg.hidden, cfg.normalise)
         self.optimiser = optax.adam(cfg.learning_rate)
+        if mesh is not None:
+            check(cfg.num_envs % mesh.size == 0, "num_envs", cfg.num_envs, f"a multiple of the {mesh.size} devices")
+            # a model first built inside shard_map's trace would carry its manual axis into evaluation
+            getattr(env, "mjx_model", None)
+        self.mesh = mesh
 
     def hyper(self, sigma: float | None = None, horizon: int | None = None) -> Hyper:
         return Hyper(
@@ -72,27 +84,26 @@ class Trainer:
         )
 
     def iteration(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
+        """One iteration; with a mesh, every device runs this same program on the whole state and
+        only exploration and SELECT are split (``explore_and_select``), so the run computes bit for
+        bit what one device computes."""
+        if self.mesh is None:
+            return self._iteration(ts, hyper)
+        whole = P()
+        return jax.shard_map(
+            self._iteration, mesh=self.mesh, in_specs=(whole, whole), out_specs=(whole, whole), check_vma=False
+        )(ts, hyper)
+
+    def _iteration(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
         env, cfg, policy = self.env, self.cfg, self.policy
         key, k_explore, k_bc, k_relabel = jax.random.split(ts.key, 4)
-        traj = explore(env, policy, ts.policy, k_explore, cfg.num_envs, hyper.sigma)
+        reset_keys, noise = draws(env, k_explore, cfg.num_envs)
+        horizon = self.horizon_at(ts.iteration, hyper)
+        seen, cands = self.explore_and_select(ts.policy, reset_keys, noise, hyper.sigma, horizon)
         if cfg.algo == "gcsl":
-            cands = gcsl.relabel(env, traj, cfg.gcsl_relabel, k_relabel)
-        else:
-            cands = select(
-                env,
-                policy,
-                ts.policy,
-                traj,
-                self.max_horizon,
-                self.horizon_at(ts.iteration, hyper),
-                cfg.select,
-                cfg.select_lanes,
-                hold=cfg.relabel in ("hold", "settle"),
-                settle=cfg.relabel == "settle",
-                radius=cfg.select_radius,
-            )
+            cands = gcsl.relabel(env, seen, cfg.gcsl_relabel, k_relabel)
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
-        pstate = policy.update_normaliser(ts.policy, traj.states.obs, traj.achieved[:-1], ~traj.invalid[:-1])
+        pstate = policy.update_normaliser(ts.policy, seen.obs, seen.achieved[:-1], ~seen.invalid[:-1])
         pstate, opt_state, online, loss = bc_epoch(
             policy,
             self.optimiser,
@@ -112,12 +123,54 @@ class Trainer:
             "select_accepted": jnp.sum(cands.accept, dtype=jnp.int32),
             "select_steps": cands.replay_steps,
             "bc_loss": loss,
-            "explore_success": jnp.mean(jnp.any(traj.states.success, axis=0)),
+            "explore_success": jnp.mean(jnp.any(seen.success, axis=0)),
         }
         new = TrainState(
             policy=pstate, opt_state=opt_state, online=online, buffer=buf, key=key, iteration=ts.iteration + 1
         )
         return new, metrics
+
+    def explore_and_select(self, pstate, reset_keys, noise, sigma, horizon) -> tuple[Seen, Candidates | None]:
+        """Explore the envs and, but for GCSL, SELECT among their relabelled pairs: all of them, or,
+        inside the mesh's ``shard_map``, this device's slice, gathered back in the one-device layout."""
+        if self.mesh is None:
+            return self._explore_and_select(pstate, reset_keys, noise, sigma, horizon)
+        n = self.cfg.num_envs // self.mesh.size
+        first = jax.lax.axis_index(ENVS) * n
+        seen, cands = self._explore_and_select(
+            pstate,
+            jax.lax.dynamic_slice_in_dim(reset_keys, first, n, axis=0),
+            jax.lax.dynamic_slice_in_dim(noise, first, n, axis=1),
+            sigma,
+            horizon,
+        )
+        gather = lambda x: jax.lax.all_gather(x, ENVS, axis=1, tiled=True)  # noqa: E731  [T, n] -> [T, N]
+        seen = jax.tree.map(gather, seen)
+        if cands is None:
+            return seen, None
+        # [H*T*n] in layout [H, T, n] -> [H*T, N] -> the one-device layout [H, T, N]
+        whole = [gather(x.reshape((-1, n) + x.shape[1:])).reshape((-1,) + x.shape[1:]) for x in cands[:-1]]
+        return seen, Candidates(*whole, jax.lax.psum(cands.replay_steps, ENVS))
+
+    def _explore_and_select(self, pstate, reset_keys, noise, sigma, horizon) -> tuple[Seen, Candidates | None]:
+        env, cfg = self.env, self.cfg
+        traj = rollout(env, self.policy, pstate, reset_keys, noise, sigma)
+        if cfg.algo == "gcsl":
+            return traj.seen(), None
+        cands = select(
+            env,
+            self.policy,
+            pstate,
+            traj,
+            self.max_horizon,
+            horizon,
+            cfg.select,
+            cfg.select_lanes,
+            hold=cfg.relabel in ("hold", "settle"),
+            settle=cfg.relabel == "settle",
+            radius=cfg.select_radius,
+        )
+        return traj.seen(), cands
 
     def horizon_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
         """The learning horizon of this iteration: H, or PCHID's curriculum 1, 2, ..., H."""

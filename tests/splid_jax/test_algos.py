@@ -39,7 +39,7 @@ def stable(run_dir):
 
 def final_state(run_dir):
     with open(os.path.join(run_dir, "config.json")) as fh:
-        cfg = TrainConfig(**json.load(fh))
+        cfg = TrainConfig.from_json(json.load(fh))
     algo = loop.make_algorithm(cfg, envs.make(cfg.env))
     step, state, _ = checkpoint.restore(str(run_dir), jax.eval_shape(algo.init, jax.random.PRNGKey(0)))
     return step, jax.tree_util.tree_leaves(state)

@@ -25,7 +25,7 @@ def traj():
 
 def test_final_pairs_every_step_with_the_episodes_last_achieved_goal(traj):
     env, tr = traj
-    c = gcsl.relabel(env, tr, "final", jax.random.PRNGKey(0))
+    c = gcsl.relabel(env, tr.seen(), "final", jax.random.PRNGKey(0))
     np.testing.assert_array_equal(c.goal.reshape(T, N, -1), np.broadcast_to(tr.achieved[T], (T, N, 2)))
     np.testing.assert_array_equal(c.action.reshape(T, N, -1), tr.actions)
     assert bool(c.accept.all()) and int(c.replay_steps) == 0
@@ -36,7 +36,7 @@ def test_future_goals_come_uniformly_from_later_steps_of_the_same_episode(traj):
     achieved = np.asarray(tr.achieved)
     later = []
     for seed in range(40):
-        goal = np.asarray(gcsl.relabel(env, tr, "future", jax.random.PRNGKey(seed)).goal).reshape(T, N, 2)
+        goal = np.asarray(gcsl.relabel(env, tr.seen(), "future", jax.random.PRNGKey(seed)).goal).reshape(T, N, 2)
         for t in range(T):
             for n in range(N):
                 (match,) = np.nonzero((achieved[:, n] == goal[t, n]).all(-1))

@@ -48,7 +48,7 @@ def stable(path):
 
 
 def final_params(run_dir):
-    cfg = TrainConfig(**{**json.load(open(os.path.join(run_dir, "config.json"))), "hidden": (32, 32)})
+    cfg = TrainConfig.from_json(json.load(open(os.path.join(run_dir, "config.json"))), hidden=(32, 32))
     trainer = Trainer(__import__("envs").make("point"), cfg)
     _, state, _ = checkpoint.restore(run_dir, trainer.init(jax.random.PRNGKey(0)))
     return jax.tree_util.tree_leaves(state)
