@@ -16,6 +16,7 @@ _REGISTRY = {
     "slide": "envs.fetch.tasks:Slide",
     "pick_and_place": "envs.fetch.tasks:PickAndPlace",
     "reacher": "envs.reacher:Reacher",
+    "sawyer_door": "envs.sawyer_door:SawyerDoor",
 }
 
 
