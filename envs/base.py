@@ -70,6 +70,18 @@ class GoalEnv(abc.ABC):
 
     @property
     @abc.abstractmethod
+    def achieved_goal_start(self) -> int:
+        """Where the achieved goal begins in the observation: ``obs[start : start + goal_size]`` is
+        ``achieved_goal``, so a policy can be fed the goal relative to it."""
+
+    @property
+    @abc.abstractmethod
+    def success_distance(self) -> float:
+        """The distance between achieved and desired goal within which ``success`` holds: the unit a
+        policy sees the relative goal in, so that 1 is the edge of success on every task."""
+
+    @property
+    @abc.abstractmethod
     def episode_length(self) -> int: ...
 
     @abc.abstractmethod

@@ -68,6 +68,8 @@ class PointFourRooms(GoalEnv):
 
     obs_size = property(lambda self: 2)
     goal_size = property(lambda self: 2)
+    achieved_goal_start = property(lambda self: 0)
+    success_distance = property(lambda self: self.success_radius)
     action_size = property(lambda self: 2)
     episode_length = property(lambda self: self.max_episode_steps)
 

@@ -94,6 +94,8 @@ class Reacher(GoalEnv):
 
     obs_size = property(lambda self: 11)
     goal_size = property(lambda self: 2)
+    achieved_goal_start = property(lambda self: 8)  # the fingertip's XY
+    success_distance = property(lambda self: self.success_threshold**0.5)
     action_size = property(lambda self: 2)
     episode_length = property(lambda self: self.max_episode_steps)
     dt = property(lambda self: self.timestep * self.frame_skip)

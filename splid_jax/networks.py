@@ -51,14 +51,27 @@ class Policy:
     net: MLP = struct.field(pytree_node=False)
     in_size: int = struct.field(pytree_node=False)
     normalise: bool = struct.field(pytree_node=False, default=True)
+    # (start, stop) of the achieved goal inside the observation: the policy is also fed goal - achieved,
+    # the quantity a goal-reaching action depends on, rather than left to subtract two absolute positions,
+    # in units of ``goal_unit`` (the task's success distance), so 1 is the edge of success
+    achieved_slice: tuple[int, int] | None = struct.field(pytree_node=False, default=None)
+    goal_unit: float = struct.field(pytree_node=False, default=1.0)
 
     def init(self, key: jax.Array) -> PolicyState:
         params = self.net.init(key, jnp.zeros((self.in_size,)))
         normaliser = running_statistics.init_state(jnp.zeros((self.in_size,), jnp.float32))
         return PolicyState(params=params, normaliser=normaliser)
 
+    def features(self, obs: jax.Array, goal: jax.Array) -> jax.Array:
+        """The network's input before normalisation: observation, goal and, with ``achieved_slice``,
+        the goal relative to the achieved goal."""
+        parts = [obs, goal]
+        if self.achieved_slice is not None:
+            parts.append((goal - obs[..., self.achieved_slice[0] : self.achieved_slice[1]]) / self.goal_unit)
+        return jnp.concatenate(parts, axis=-1)
+
     def _inputs(self, pstate: PolicyState, obs: jax.Array, goal: jax.Array) -> jax.Array:
-        x = jnp.concatenate([obs, goal], axis=-1)
+        x = self.features(obs, goal)
         if self.normalise:
             x = running_statistics.normalize(x, pstate.normaliser, max_abs_value=CLIP_NORMALISED)
         return x
@@ -79,14 +92,29 @@ class Policy:
         seen in that episode) carry no weight and are zeroed, since 0 * NaN would still poison them."""
         if not self.normalise:
             return pstate
-        x = jnp.concatenate([obs, goal], axis=-1).reshape(-1, self.in_size)
+        x = self.features(obs, goal).reshape(-1, self.in_size)
         w = jnp.ones(x.shape[0], jnp.float32) if valid is None else valid.reshape(-1).astype(jnp.float32)
         x = jnp.where(w[:, None] > 0, x, 0.0)
         stats = running_statistics.update(pstate.normaliser, x, weights=w, std_min_value=STD_MIN)
         return pstate.replace(normaliser=stats)
 
 
-def make_policy(obs_size: int, goal_size: int, action_size: int, hidden: Sequence[int], normalise: bool) -> Policy:
+def make_policy(
+    obs_size: int,
+    goal_size: int,
+    action_size: int,
+    hidden: Sequence[int],
+    normalise: bool,
+    achieved_slice: tuple[int, int] | None = None,
+    goal_unit: float = 1.0,
+) -> Policy:
+    if achieved_slice is not None:
+        start, stop = achieved_slice
+        assert 0 <= start and stop - start == goal_size and stop <= obs_size, (achieved_slice, obs_size, goal_size)
     return Policy(
-        net=MLP(hidden=tuple(hidden), action_size=action_size), in_size=obs_size + goal_size, normalise=normalise
+        net=MLP(hidden=tuple(hidden), action_size=action_size),
+        in_size=obs_size + goal_size * (1 if achieved_slice is None else 2),
+        normalise=normalise,
+        achieved_slice=None if achieved_slice is None else tuple(achieved_slice),
+        goal_unit=float(goal_unit),
     )

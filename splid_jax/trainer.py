@@ -56,7 +56,10 @@ class Trainer:
         self.env, self.cfg, self.name = env, cfg, cfg.algo
         self.max_horizon = cfg.horizon  # shapes; a sweep's members mask larger h through Hyper.horizon
         self.pchid_every = max(1, cfg.pchid_every)  # TrainConfig resolves 0 for pchid
-        self.policy = make_policy(env.obs_size, env.goal_size, env.action_size, cfg.hidden, cfg.normalise)
+        achieved = (env.achieved_goal_start, env.achieved_goal_start + env.goal_size) if cfg.relative_goal else None
+        self.policy = make_policy(
+            env.obs_size, env.goal_size, env.action_size, cfg.hidden, cfg.normalise, achieved, env.success_distance
+        )
         self.optimiser = optax.adam(cfg.learning_rate)
         if mesh is not None:
             check(cfg.num_envs % mesh.size == 0, "num_envs", cfg.num_envs, f"a multiple of the {mesh.size} devices")
@@ -99,7 +102,8 @@ class Trainer:
         key, k_explore, k_bc, k_relabel = jax.random.split(ts.key, 4)
         reset_keys, noise = draws(env, k_explore, cfg.num_envs)
         horizon = self.horizon_at(ts.iteration, hyper)
-        seen, cands = self.explore_and_select(ts.policy, reset_keys, noise, hyper.sigma, horizon)
+        sigma = self.sigma_at(ts.iteration, hyper)
+        seen, cands = self.explore_and_select(ts.policy, reset_keys, noise, sigma, horizon)
         if cfg.algo == "gcsl":
             cands = gcsl.relabel(env, seen, cfg.gcsl_relabel, k_relabel)
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
@@ -171,6 +175,13 @@ class Trainer:
             radius=cfg.select_radius,
         )
         return traj.seen(), cands
+
+    def sigma_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
+        """This iteration's exploration noise: sigma, falling linearly to sigma_end x sigma over the
+        first sigma_anneal iterations."""
+        span = max(1, self.cfg.sigma_anneal - 1)
+        progress = jnp.minimum(iteration, span).astype(jnp.float32) / span
+        return hyper.sigma * (1.0 - (1.0 - self.cfg.sigma_end) * progress)
 
     def horizon_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
         """The learning horizon of this iteration: H, or PCHID's curriculum 1, 2, ..., H."""

@@ -145,6 +145,8 @@ class _FetchTask(GoalEnv):
     # ---- sizes -------------------------------------------------------------------------------
     obs_size = property(lambda self: 25 if self.has_object else 10)
     goal_size = property(lambda self: 3)
+    achieved_goal_start = property(lambda self: 3 if self.has_object else 0)  # object, else grip position
+    success_distance = property(lambda self: self.distance_threshold)
     action_size = property(lambda self: 4)
     episode_length = property(lambda self: self.max_episode_steps)
 

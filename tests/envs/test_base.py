@@ -3,6 +3,9 @@
 
 import chex
 import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
 
 import envs
 from envs.base import CPU_STEP_SLICE, step_batch
@@ -35,3 +38,15 @@ def test_a_cpu_computation_on_an_accelerator_host_is_sliced(monkeypatch, primiti
         assert "scan" in prims()  # placed on the CPU: lax.map over slices
 
 
+
+
+@pytest.mark.parametrize("name", envs.names())
+def test_the_achieved_goal_sits_where_the_task_says_and_success_ends_at_its_distance(name):
+    env = envs.make(name)
+    s = jax.vmap(env.reset)(jax.random.split(jax.random.PRNGKey(0), 4))
+    start = env.achieved_goal_start
+    np.testing.assert_array_equal(s.obs[:, start : start + env.goal_size], s.achieved_goal)
+    direction = jnp.zeros(env.goal_size).at[0].set(1.0)
+    inside = s.achieved_goal + 0.99 * env.success_distance * direction
+    outside = s.achieved_goal + 1.01 * env.success_distance * direction
+    assert bool(env.success(s.achieved_goal, inside).all()) and not bool(env.success(s.achieved_goal, outside).any())

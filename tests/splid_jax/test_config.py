@@ -42,3 +42,9 @@ def test_pchid_schedule_is_resolved_once_so_a_longer_resume_keeps_it():
     resumed = TrainConfig(**{**cfg.to_json(), "hidden": tuple(cfg.hidden), "iterations": 80})
     assert resumed.pchid_every == 5
     assert TrainConfig(env="point", iterations=40).pchid_every == 0  # other learners leave it unset
+
+
+@pytest.mark.parametrize("field, value", [("sigma_end", -0.1), ("sigma_end", 1.5), ("sigma_anneal", 0)])
+def test_sigma_schedule_outside_its_range_names_the_field(field, value):
+    with pytest.raises(InvalidConfig, match=field):
+        TrainConfig(env="point", **{field: value})

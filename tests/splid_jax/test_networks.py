@@ -55,3 +55,15 @@ def test_trained_policy_barely_moves_under_a_small_offset_of_any_input():
     # The finger's 1e-3 is 0.1 std under the floor; its first-layer weights never trained, so it moves
     # the action by about 0.05 (without the floor: 1e-3 / 1e-6 hits the clip of 5 std, and 1.4).
     assert worst < 0.1, worst
+
+
+def test_relative_goal_input_is_the_goal_minus_the_achieved_goal_in_success_units():
+    policy = make_policy(5, 2, 2, (8,), normalise=False, achieved_slice=(1, 3), goal_unit=0.05)
+    obs = jnp.asarray([[9.0, 1.0, 2.0, 7.0, 8.0]])
+    goal = jnp.asarray([[1.1, 1.5]])
+    np.testing.assert_allclose(policy.features(obs, goal)[0, -2:], [2.0, -10.0], rtol=1e-5)
+    assert policy.in_size == 5 + 2 + 2
+    pstate = policy.init(jax.random.PRNGKey(0))
+    assert policy.act(pstate, obs, goal).shape == (1, 2)
+    # the same obs and goal moved together leave the relative input as it was
+    np.testing.assert_allclose(policy.features(obs.at[:, 1:3].add(0.3), goal + 0.3)[0, -2:], [2.0, -10.0], rtol=1e-4)

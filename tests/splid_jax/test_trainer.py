@@ -88,3 +88,11 @@ def test_select_accepts_fewer_pairs_than_the_ablation(trainer, learned):
     assert int(without["select_accepted"]) == int(without["select_pairs"])
     assert int(with_select["select_accepted"]) < int(with_select["select_pairs"])
     assert int(with_select["select_accepted"]) < int(without["select_accepted"])
+
+
+def test_exploration_noise_falls_linearly_to_its_end_fraction_and_stays():
+    t = Trainer(envs.make("point"), TrainConfig(**{**CFG, "sigma": 2.0, "sigma_end": 0.25, "sigma_anneal": 11}))
+    sigma = [float(t.sigma_at(jnp.int32(i), t.hyper())) for i in (0, 5, 10, 30)]
+    np.testing.assert_allclose(sigma, [2.0, 1.25, 0.5, 0.5], rtol=1e-6)
+    constant = Trainer(envs.make("point"), TrainConfig(**CFG))
+    assert float(constant.sigma_at(jnp.int32(30), constant.hyper())) == 1.0
