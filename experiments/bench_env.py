@@ -42,7 +42,7 @@ with contextlib.redirect_stdout(io.StringIO()):  # mujoco.mjx prints a note abou
 import envs  # noqa: E402
 from envs.base import step_batch  # noqa: E402
 
-TASKS = ["reach", "push", "slide", "pick_and_place"]
+TASKS = ["reach", "push", "slide", "pick_and_place", "reacher", "sawyer_door"]
 GPU_BATCHES = [1024, 2048, 4096, 8192, 16384, 32768, 65536]
 CPU_BATCHES = [16, 64]
 
@@ -90,7 +90,7 @@ def bench_one(task: str, overrides: dict, batch: int, steps: int, repeats: int) 
         out = jax.block_until_ready(compiled(state, key))
         times.append(time.perf_counter() - t0)
     run_s = statistics.median(times)
-    substeps = getattr(env, "substeps", 1)
+    substeps = getattr(env, "substeps", getattr(env, "frame_skip", 1))  # physics steps per control step
     return {
         "task": task,
         "overrides": overrides,
@@ -142,7 +142,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(
         description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    p.add_argument("--tasks", nargs="+", default=TASKS, choices=TASKS, help="tasks to time (default: all four)")
+    p.add_argument("--tasks", nargs="+", default=TASKS, choices=TASKS, help="tasks to time (default: all)")
     p.add_argument(
         "--batch",
         nargs="+",
