@@ -75,6 +75,11 @@ SPECS: dict[str, Spec] = {
     "fig5": Spec("SPLID's exploration factor sigma", ("splid",), SUCCESS, "sigma", (0.25, 0.5, 1.0, 2.0)),
     "fig6": Spec("SPLID with and without SELECT", ("splid", "no-select"), (("eval_return", "average return"),)),
 }
+# The paper's Figures 8 and 9 are the same runs (SPLID and GCSL on its appendix tasks) drawn as average
+# return and as success: here one figure with both, made by either name.
+SPECS["fig8"] = SPECS["fig9"] = Spec(
+    "SPLID against GCSL", ("splid", "gcsl"), (("eval_return", "average return"),) + SUCCESS
+)
 SHORT = {"horizon": "H", "sigma": "sigma"}  # a swept field's name in member names and labels
 
 # Exploration episodes per method by default (the paper's x axes); other tasks: their default run's.
@@ -401,7 +406,8 @@ def title(record: dict, series: Sequence[Series]) -> str:
 def draw(record: dict, series: Sequence[Series]) -> Figure:
     spec = SPECS[record["figure"]]
     fig = Figure(figsize=(max(9.0, 6.5 * len(spec.panels)), 5.2), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(1, len(spec.panels), sharey=True))
+    returns = [metric == "eval_return" for metric, _ in spec.panels]
+    axes = np.atleast_1d(fig.subplots(1, len(spec.panels), sharey=len(set(returns)) == 1))
     cmap = matplotlib.colormaps["tab10"]
     for i, s in enumerate(series):
         x = s.columns["episodes"]
@@ -425,7 +431,9 @@ def draw(record: dict, series: Sequence[Series]) -> Figure:
         ax.grid(alpha=0.3)
         if metric != "eval_return":
             ax.set_ylim(-0.02, 1.02)
-    axes[0].set_ylabel("average return" if spec.panels[0][0] == "eval_return" else "evaluation success rate")
+    for i, (ax, is_return) in enumerate(zip(axes, returns, strict=True)):
+        if i == 0 or is_return != returns[i - 1]:  # each new scale names itself
+            ax.set_ylabel("average return" if is_return else "evaluation success rate")
     handles, names = axes[0].get_legend_handles_labels()
     if handles:
         fig.legend(handles, names, loc="outside lower center", ncols=min(len(names), 3), fontsize="small")
@@ -457,8 +465,8 @@ fig3: SPLID, GCSL, PCHID, HER, ES and SPLID without SELECT, success at any step 
 fig4: SPLID with H in 1, 2, 4, 8, 16 (one sweep).
 fig5: SPLID with sigma in 0.25, 0.5, 1, 2 (one sweep).
 fig6: average return of SPLID with and without SELECT.
-Figures 8 and 9 (SPLID and GCSL on Point2D-FourRooms, Reacher and SawyerDoor) are not offered yet: the
-Reacher and SawyerDoor tasks do not exist.
+fig8, fig9: SPLID and GCSL, average return (the paper's Figure 8) and success (Figure 9) from the same
+      runs in one figure; the paper's tasks are point, reacher and sawyer_door.
 
 Each method is one vmapped sweep in OUT/METHOD/ (the sweep's checkpoints, one run directory per
 member); OUT/figure.json records the command, device, date and what each method ran; the PNG and the
@@ -479,7 +487,7 @@ def build_parser() -> Parser:
     )
     parser.add_argument("figure", choices=sorted(SPECS), help="which figure")
     parser.add_argument(
-        "--env", default=None, help="task: " + ", ".join(envs.names()) + " (default push; --quick: point)"
+        "--env", default=None, help="task: " + ", ".join(envs.names()) + " (default push; fig8, fig9, --quick: point)"
     )
     parser.add_argument(
         "--methods", default=None, help="fig3: a comma-separated subset of " + ", ".join(METHODS) + " (default: all)"
@@ -540,7 +548,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ns = parser.parse_args(argv)
     spec = SPECS[ns.figure]
     today = datetime.date.today().isoformat()
-    env_name = ns.env or ("point" if ns.quick else "push")
+    env_name = ns.env or ("point" if ns.quick or ns.figure in ("fig8", "fig9") else "push")
     out = ns.out or (
         os.path.join("runs", today, f"{ns.figure}-{env_name}-quick")
         if ns.quick

@@ -179,9 +179,8 @@ class Trainer:
     def sigma_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
         """This iteration's exploration noise: sigma, falling linearly to sigma_end x sigma over the
         first sigma_anneal iterations."""
-        span = max(1, self.cfg.sigma_anneal - 1)
-        progress = jnp.minimum(iteration, span).astype(jnp.float32) / span
-        return hyper.sigma * (1.0 - (1.0 - self.cfg.sigma_end) * progress)
+        fraction = optax.linear_schedule(1.0, self.cfg.sigma_end, max(1, self.cfg.sigma_anneal - 1))
+        return hyper.sigma * fraction(iteration)
 
     def horizon_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
         """The learning horizon of this iteration: H, or PCHID's curriculum 1, 2, ..., H."""

@@ -124,12 +124,13 @@ def test_replot_of_a_dir_without_a_figure_is_one_line(capsys, tmp_path):
     assert len(err.splitlines()) == 1 and "figure.json" in err
 
 
-def test_help_names_the_figures_it_leaves_out(capsys):
+def test_help_names_every_figure_and_says_fig8_and_fig9_are_one(capsys):
     with pytest.raises(SystemExit) as exc:
         figures.main(["--help"])
     assert exc.value.code == 0
     text = " ".join(capsys.readouterr().out.split())
-    assert "Figures 8 and 9" in text and "Reacher and SawyerDoor tasks do not exist" in text
+    assert all(f"{name}:" in text or f"{name}," in text for name in figures.SPECS)
+    assert "fig8, fig9: SPLID and GCSL" in text
 
 
 def test_every_method_runs_whole_chunks_nearest_the_budget(tmp_path):
@@ -213,3 +214,24 @@ def test_pchid_reaches_its_full_horizon_half_way_through_the_figure_run(tmp_path
     (p,) = figures.plan(spec, "point", ("pchid",), 1, 16 * 40 * 4, sets, str(tmp_path))
     assert p.base.pchid_every == max(1, p.base.iterations // (2 * p.base.horizon))
     assert all(lane.pchid_every == p.base.pchid_every for lane in p.lanes)
+
+
+@pytest.mark.parametrize("figure", ["fig8", "fig9"])
+def test_fig8_and_fig9_draw_return_and_both_success_measures_of_splid_and_gcsl(tmp_path, figure):
+    assert figures.SPECS[figure].methods == ("splid", "gcsl")
+    fake_figure(tmp_path, figure, {
+        "splid": [({"seed": 0, "algo": "splid"}, [0.2, 0.6]), ({"seed": 1, "algo": "splid"}, [0.4, 1.0])],
+        "gcsl": [({"seed": 0, "algo": "gcsl", "gcsl_relabel": "final"}, [0.1, 0.3])],
+    })  # fmt: skip
+    png, table = figures.render(str(tmp_path), quiet=True)
+    table = rows(Path(table))
+    splid = [r for r in table if r["method"] == "splid"]
+    assert [float(r["eval_return_mean"]) for r in splid] == pytest.approx([3.0, 8.0])
+    assert [float(r["eval_success_final_mean"]) for r in splid] == pytest.approx([0.15, 0.4])
+    assert Path(png).name == f"{figure}-point.png" and Path(png).read_bytes()[:8] == PNG_MAGIC
+    record = figures.load_record(str(tmp_path))
+    fig = figures.draw(record, figures.load_series(str(tmp_path), record))
+    return_axis, any_axis, final_axis = fig.axes
+    assert return_axis.get_ylabel() == "average return" and any_axis.get_ylabel() == "evaluation success rate"
+    assert return_axis.get_ylim()[1] > 7  # its own scale, not the success panels' [0, 1]
+    assert final_axis.get_ylim() == any_axis.get_ylim()
