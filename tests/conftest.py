@@ -117,3 +117,27 @@ class FetchEpisodes:
 @pytest.fixture(scope="session")
 def fetch():
     return FetchEpisodes()
+
+
+@functools.cache
+def _scripted_or_given(env, controller):
+    @jax.jit
+    def run(start, actions, use_script):
+        """T steps from ``start`` [N]: ``controller``'s actions, or the given ones [T, N, A]; returns the
+        states after each step and the actions taken."""
+
+        def one(s, a):
+            a = jnp.where(use_script, jax.vmap(controller)(s), a)
+            n = jax.vmap(env.step)(s, a)
+            return n, (n, a)
+
+        return jax.lax.scan(one, start, actions)[1]
+
+    return run
+
+
+@pytest.fixture(scope="session")
+def episode_program():
+    """``episode_program(env, controller)``: one compiled episode program per task and scripted
+    controller (the tasks outside Fetch), shared by every test that steps it."""
+    return _scripted_or_given

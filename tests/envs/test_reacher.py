@@ -1,7 +1,6 @@
 """Reacher: the contract, exact restore-and-replay, and a scripted controller that reaches, from
 one compiled episode program (8 envs, 50 steps) shared by every test."""
 
-import functools
 
 import jax
 import jax.numpy as jnp
@@ -15,32 +14,16 @@ from envs.reacher import fingertip, scripted
 N = 8
 
 
-@functools.cache
-def _program(env):
-    @jax.jit
-    def run(start, actions, use_script):
-        """T steps from ``start`` [N]: the scripted controller's actions, or the given ones [T, N, 2]."""
-
-        def one(s, a):
-            a = jnp.where(use_script, jax.vmap(scripted)(s), a)
-            n = jax.vmap(env.step)(s, a)
-            return n, (n, a)
-
-        return jax.lax.scan(one, start, actions)[1]
-
-    return run
-
-
 @pytest.fixture(scope="module")
 def env():
     return envs.make("reacher")
 
 
 @pytest.fixture(scope="module")
-def episodes(env):
+def episodes(env, episode_program):
     start = jax.vmap(env.reset)(jax.random.split(jax.random.PRNGKey(0), N))
     noise = jax.random.uniform(jax.random.PRNGKey(1), (env.episode_length, N, 2), minval=-1.0, maxval=1.0)
-    run = _program(env)
+    run = episode_program(env, scripted)
     return start, noise, run(start, noise, False), run(start, noise, True)
 
 
@@ -68,12 +51,12 @@ def test_random_actions_move_the_arm_and_the_goal_test_uses_the_squared_distance
     np.testing.assert_array_equal(states.reward, states.success.astype(jnp.float32) - 1.0)
 
 
-def test_a_saved_state_replays_bit_for_bit(env, episodes):
+def test_a_saved_state_replays_bit_for_bit(env, episodes, episode_program):
     start, noise, (states, _), _ = episodes
     k = 10
     saved = jax.tree_util.tree_map(lambda x: x[k - 1], states)  # the state after k steps
     rest = jnp.concatenate([noise[k:], jnp.zeros((k, N, 2))])  # padded to the program's length
-    replay, _ = _program(env)(saved, rest, False)
+    replay, _ = episode_program(env, scripted)(saved, rest, False)
     np.testing.assert_array_equal(replay.obs[: 50 - k], states.obs[k:])
     np.testing.assert_array_equal(replay.physics.qvel[: 50 - k], states.physics.qvel[k:])
 

@@ -1,7 +1,6 @@
 """SawyerDoor: the contract, exact restore-and-replay, and a scripted controller that opens the door to
 the goal and back, from one compiled episode program (8 envs, 50 steps) shared by every test."""
 
-import functools
 
 import jax
 import jax.numpy as jnp
@@ -15,32 +14,16 @@ from envs.sawyer_door import GOAL_MAX, HINGE_MAX, WORKSPACE, scripted
 N = 8
 
 
-@functools.cache
-def _program(env):
-    @jax.jit
-    def run(start, actions, use_script):
-        """T steps from ``start`` [N]: the scripted controller's actions, or the given ones [T, N, 3]."""
-
-        def one(s, a):
-            a = jnp.where(use_script, jax.vmap(scripted)(s), a)
-            n = jax.vmap(env.step)(s, a)
-            return n, (n, a)
-
-        return jax.lax.scan(one, start, actions)[1]
-
-    return run
-
-
 @pytest.fixture(scope="module")
 def env():
     return envs.make("sawyer_door")
 
 
 @pytest.fixture(scope="module")
-def episodes(env):
+def episodes(env, episode_program):
     start = jax.vmap(env.reset)(jax.random.split(jax.random.PRNGKey(0), N))
     noise = jax.random.uniform(jax.random.PRNGKey(1), (env.episode_length, N, 3), minval=-1.0, maxval=1.0)
-    run = _program(env)
+    run = episode_program(env, scripted)
     return start, noise, run(start, noise, False), run(start, noise, True)
 
 
@@ -75,12 +58,12 @@ def test_random_actions_move_the_hand_within_its_box_and_success_is_the_angle_er
     np.testing.assert_array_equal(states.reward, states.success.astype(jnp.float32) - 1.0)
 
 
-def test_a_saved_state_replays_bit_for_bit(env, episodes):
+def test_a_saved_state_replays_bit_for_bit(env, episodes, episode_program):
     _, _, _, (states, actions) = episodes  # the scripted run: the hand in the hook, the door moving
     k = 15
     saved = jax.tree_util.tree_map(lambda x: x[k - 1], states)  # the state after k steps
     rest = jnp.concatenate([actions[k:], jnp.zeros((k, N, 3))])  # padded to the program's length
-    replay, _ = _program(env)(saved, rest, False)
+    replay, _ = episode_program(env, scripted)(saved, rest, False)
     assert float(jnp.max(jnp.abs(states.physics.qvel[k:, :, 0]))) > 0.1  # the door swings after the save
     np.testing.assert_array_equal(replay.obs[: 50 - k], states.obs[k:])
     np.testing.assert_array_equal(replay.physics.qvel[: 50 - k], states.physics.qvel[k:])
@@ -97,12 +80,12 @@ def test_the_scripted_controller_opens_the_door_to_the_goal_and_holds_it(env, ep
     assert float(jnp.max(jnp.abs(actions))) <= 1.0
 
 
-def test_the_scripted_controller_pulls_the_door_back(env, episodes):
+def test_the_scripted_controller_pulls_the_door_back(env, episodes, episode_program):
     _, noise, _, (states, _) = episodes
     opened = jax.tree_util.tree_map(lambda x: x[-1], states)
     back = GOAL_MAX - opened.desired_goal  # wide open doors go nearly shut, nearly shut ones wide open
     retargeted = jax.vmap(env.with_goal)(opened, back)
-    closing, _ = _program(env)(retargeted, noise, True)
+    closing, _ = episode_program(env, scripted)(retargeted, noise, True)
     assert bool(jnp.any(back[:, 0] < opened.achieved_goal[:, 0] - 0.3))  # some doors must swing well back
     assert bool(jnp.all(closing.success[-1]))
 
