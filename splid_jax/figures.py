@@ -397,8 +397,10 @@ def title(record: dict, series: Sequence[Series]) -> str:
     seeds = sorted({s.seeds for s in series})
     per = "setting" if spec.vary else "method"
     n = "-".join(str(k) for k in (seeds[0], seeds[-1]) if k) if len(seeds) > 1 else str(seeds[0])
+    numbers = [name[3:] for name, other in SPECS.items() if other is spec]  # a figure drawn under two names
+    figure = f"Figures {' and '.join(numbers)}" if len(numbers) > 1 else f"Figure {numbers[0]}"
     return (
-        f"Figure {record['figure'][3:]}: {spec.title} on {record['env']}, {record['budget_episodes']:,} exploration "
+        f"{figure}: {spec.title} on {record['env']}, {record['budget_episodes']:,} exploration "
         f"episodes per {per}\n{n} seeds per {per}, mean and standard error; {record['device']}, {record['date']}"
     )
 

@@ -235,3 +235,4 @@ def test_fig8_and_fig9_draw_return_and_both_success_measures_of_splid_and_gcsl(t
     assert return_axis.get_ylabel() == "average return" and any_axis.get_ylabel() == "evaluation success rate"
     assert return_axis.get_ylim()[1] > 7  # its own scale, not the success panels' [0, 1]
     assert final_axis.get_ylim() == any_axis.get_ylim()
+    assert fig._suptitle.get_text().startswith("Figures 8 and 9: SPLID against GCSL on point")
