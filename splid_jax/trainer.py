@@ -198,6 +198,7 @@ class Trainer:
             select_held=jnp.sum(per_iter["select_held"]),
             select_held_accepted=jnp.sum(per_iter["select_held_accepted"]),
             horizon=self.horizon_at(ts.iteration - 1, hyper),
+            sigma=self.sigma_at(ts.iteration - 1, hyper),
             select_steps=per_iter["select_steps"],  # [eval_every]: summed on the host, where ints do not overflow
             bc_loss=per_iter["bc_loss"][-1],
             explore_success=jnp.mean(per_iter["explore_success"]),

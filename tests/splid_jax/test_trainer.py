@@ -94,5 +94,7 @@ def test_exploration_noise_falls_linearly_to_its_end_fraction_and_stays():
     t = Trainer(envs.make("point"), TrainConfig(**{**CFG, "sigma": 2.0, "sigma_end": 0.25, "sigma_anneal": 11}))
     sigma = [float(t.sigma_at(jnp.int32(i), t.hyper())) for i in (0, 5, 10, 30)]
     np.testing.assert_allclose(sigma, [2.0, 1.25, 0.5, 0.5], rtol=1e-6)
+    state, metrics = jax.jit(t.chunk)(t.init(jax.random.PRNGKey(0)), t.hyper())  # eval_every 10 iterations
+    assert float(metrics["sigma"]) == pytest.approx(2.0 * (1 - 0.75 * 0.9))  # the last one's: iteration 9
     constant = Trainer(envs.make("point"), TrainConfig(**CFG))
     assert float(constant.sigma_at(jnp.int32(30), constant.hyper())) == 1.0
