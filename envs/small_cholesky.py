@@ -6,8 +6,8 @@ start and at each iteration), each through ``jax.scipy.linalg.cho_factor`` / ``c
 ``vmap`` on a GPU those become batched cuSOLVER / cuBLAS calls that are slow for such tiny matrices:
 65,536 9 x 9 factor-and-solves took 0.388 ms on an H200, against 0.053 ms for the same arithmetic
 unrolled here, which XLA fuses into element-wise kernels (``experiments/bench_cholesky.py``). Push
-then runs 1.65x the control steps per second on an H200 (``BENCHMARKS.md``, "Throughput: small
-Cholesky solves", 2026-11-23).
+then runs 1.65x the control steps per second on an H200 (``BENCHMARKS.md``, "Throughput: task
+physics"; ``experiments/NOTES.md``, 2026-11-23).
 It is the same algorithm (the Cholesky-Banachiewicz order), so results agree with the library's to
 float rounding.
 
