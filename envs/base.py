@@ -33,6 +33,12 @@ def check(ok: bool, field: str, value: Any, allowed: str) -> None:
         raise InvalidConfig(field, value, allowed)
 
 
+def check_integer(field: str, value: Any, low: int, high: int | None = None) -> None:
+    """``check`` for an integer field in [low, high] (no upper bound when ``high`` is None)."""
+    ok = isinstance(value, int) and low <= value and (high is None or value <= high)
+    check(ok, field, value, f"an integer >= {low}" if high is None else f"an integer in [{low}, {high}]")
+
+
 @struct.dataclass
 class State:
     """One step of one episode; batch it with ``jax.vmap``."""

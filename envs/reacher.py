@@ -16,7 +16,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs.base import GoalEnv, State, check, flag_invalid
+from envs.base import GoalEnv, State, check, check_integer, flag_invalid
 
 LINKS = (0.1, 0.11)  # shoulder to elbow, elbow to fingertip (Gym's fingertip body sits at 0.11)
 FINGERTIP_Z = 0.01
@@ -77,20 +77,10 @@ class Reacher(GoalEnv):
     frame_skip: int = 2
 
     def __post_init__(self):
-        check(
-            isinstance(self.max_episode_steps, int) and self.max_episode_steps >= 2,
-            "reacher.max_episode_steps",
-            self.max_episode_steps,
-            "an integer >= 2",
-        )
+        check_integer("reacher.max_episode_steps", self.max_episode_steps, 2)
         check(self.success_threshold > 0, "reacher.success_threshold", self.success_threshold, "> 0 (m^2)")
         check(0 < self.timestep <= 0.02, "reacher.timestep", self.timestep, "in (0, 0.02] seconds")
-        check(
-            isinstance(self.frame_skip, int) and 1 <= self.frame_skip <= 20,
-            "reacher.frame_skip",
-            self.frame_skip,
-            "an integer in [1, 20]",
-        )
+        check_integer("reacher.frame_skip", self.frame_skip, 1, 20)
 
     obs_size = property(lambda self: 11)
     goal_size = property(lambda self: 2)

@@ -32,7 +32,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs.base import GoalEnv, State, check, flag_invalid
+from envs.base import GoalEnv, State, check, check_integer, flag_invalid
 
 GOAL_MAX = 0.83  # the largest goal angle (GCSL's multiworld settings), rad
 HINGE_MAX = 1.0  # the hinge's upper limit, rad
@@ -116,12 +116,7 @@ class SawyerDoor(GoalEnv):
     iterations: int = 4  # Newton iterations (and line-search iterations) per physics step
 
     def __post_init__(self):
-        check(
-            isinstance(self.max_episode_steps, int) and self.max_episode_steps >= 2,
-            "sawyer_door.max_episode_steps",
-            self.max_episode_steps,
-            "an integer >= 2",
-        )
+        check_integer("sawyer_door.max_episode_steps", self.max_episode_steps, 2)
         check(
             0 < self.success_threshold < GOAL_MAX,
             "sawyer_door.success_threshold",
@@ -131,18 +126,8 @@ class SawyerDoor(GoalEnv):
         check(0 < self.action_scale <= 0.1, "sawyer_door.action_scale", self.action_scale, "in (0, 0.1] m")
         check(self.door_damping > 0, "sawyer_door.door_damping", self.door_damping, "> 0 (N m s/rad)")
         check(0 < self.timestep <= 0.01, "sawyer_door.timestep", self.timestep, "in (0, 0.01] seconds")
-        check(
-            isinstance(self.frame_skip, int) and 1 <= self.frame_skip <= 40,
-            "sawyer_door.frame_skip",
-            self.frame_skip,
-            "an integer in [1, 40]",
-        )
-        check(
-            isinstance(self.iterations, int) and 1 <= self.iterations <= 100,
-            "sawyer_door.iterations",
-            self.iterations,
-            "an integer in [1, 100]",
-        )
+        check_integer("sawyer_door.frame_skip", self.frame_skip, 1, 40)
+        check_integer("sawyer_door.iterations", self.iterations, 1, 100)
 
     obs_size = property(lambda self: 4)
     goal_size = property(lambda self: 1)

@@ -32,7 +32,7 @@ import jax.numpy as jnp
 from flax import struct
 
 from envs import small_cholesky
-from envs.base import GoalEnv, State, check, flag_invalid
+from envs.base import GoalEnv, State, check, check_integer, flag_invalid
 from envs.fetch import models
 
 MIN_OBJECT_DISTANCE = 0.1  # the object starts at least this far from the gripper in xy
@@ -119,28 +119,11 @@ class _FetchTask(GoalEnv):
         check(self.workspace in spaces, f"{n}.workspace", self.workspace, "one of " + ", ".join(spaces))
         check(self.drive in models.DRIVES, f"{n}.drive", self.drive, "one of " + ", ".join(models.DRIVES))
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
-        check(
-            isinstance(self.max_episode_steps, int) and self.max_episode_steps >= 1,
-            f"{n}.max_episode_steps",
-            self.max_episode_steps,
-            "an integer >= 1",
-        )
+        check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
-        check(
-            isinstance(self.substeps, int) and 1 <= self.substeps <= 100, f"{n}.substeps", self.substeps, "in [1, 100]"
-        )
-        check(
-            isinstance(self.iterations, int) and 1 <= self.iterations <= 100,
-            f"{n}.iterations",
-            self.iterations,
-            "an integer in [1, 100]",
-        )
-        check(
-            isinstance(self.ls_iterations, int) and 1 <= self.ls_iterations <= 100,
-            f"{n}.ls_iterations",
-            self.ls_iterations,
-            "an integer in [1, 100]",
-        )
+        check_integer(f"{n}.substeps", self.substeps, 1, 100)
+        check_integer(f"{n}.iterations", self.iterations, 1, 100)
+        check_integer(f"{n}.ls_iterations", self.ls_iterations, 1, 100)
 
     # ---- sizes -------------------------------------------------------------------------------
     obs_size = property(lambda self: 25 if self.has_object else 10)
