@@ -105,16 +105,17 @@ def make_policy(
     action_size: int,
     hidden: Sequence[int],
     normalise: bool,
-    achieved_slice: tuple[int, int] | None = None,
+    achieved_start: int | None = None,
     goal_unit: float = 1.0,
 ) -> Policy:
-    if achieved_slice is not None:
-        start, stop = achieved_slice
-        assert 0 <= start and stop - start == goal_size and stop <= obs_size, (achieved_slice, obs_size, goal_size)
+    """``achieved_start``: where the achieved goal begins in the observation (the task's
+    ``achieved_goal_start``), to feed the goal relative to it; None feeds observation and goal alone."""
+    achieved = None if achieved_start is None else (achieved_start, achieved_start + goal_size)
+    assert achieved is None or 0 <= achieved[0] and achieved[1] <= obs_size, (achieved, obs_size)
     return Policy(
         net=MLP(hidden=tuple(hidden), action_size=action_size),
-        in_size=obs_size + goal_size * (1 if achieved_slice is None else 2),
+        in_size=obs_size + goal_size * (1 if achieved is None else 2),
         normalise=normalise,
-        achieved_slice=None if achieved_slice is None else tuple(achieved_slice),
+        achieved_slice=achieved,
         goal_unit=float(goal_unit),
     )

@@ -56,9 +56,14 @@ class Trainer:
         self.env, self.cfg, self.name = env, cfg, cfg.algo
         self.max_horizon = cfg.horizon  # shapes; a sweep's members mask larger h through Hyper.horizon
         self.pchid_every = max(1, cfg.pchid_every)  # TrainConfig resolves 0 for pchid
-        achieved = (env.achieved_goal_start, env.achieved_goal_start + env.goal_size) if cfg.relative_goal else None
         self.policy = make_policy(
-            env.obs_size, env.goal_size, env.action_size, cfg.hidden, cfg.normalise, achieved, env.success_distance
+            env.obs_size,
+            env.goal_size,
+            env.action_size,
+            cfg.hidden,
+            cfg.normalise,
+            achieved_start=env.achieved_goal_start if cfg.relative_goal else None,
+            goal_unit=env.success_distance,
         )
         self.optimiser = optax.adam(cfg.learning_rate)
         if mesh is not None:

@@ -58,7 +58,7 @@ def test_trained_policy_barely_moves_under_a_small_offset_of_any_input():
 
 
 def test_relative_goal_input_is_the_goal_minus_the_achieved_goal_in_success_units():
-    policy = make_policy(5, 2, 2, (8,), normalise=False, achieved_slice=(1, 3), goal_unit=0.05)
+    policy = make_policy(5, 2, 2, (8,), normalise=False, achieved_start=1, goal_unit=0.05)
     obs = jnp.asarray([[9.0, 1.0, 2.0, 7.0, 8.0]])
     goal = jnp.asarray([[1.1, 1.5]])
     np.testing.assert_allclose(policy.features(obs, goal)[0, -2:], [2.0, -10.0], rtol=1e-5)
