@@ -104,7 +104,8 @@ def run_arm(env_name: str, seeds: int, base: dict, fields: dict, trace_episodes:
 
 
 def parse_set(text: str) -> dict:
-    return {k: v for k, v in envs.parse_overrides(text, "set").items()}
+    words = {"true": True, "false": False}
+    return {k: words.get(str(v).lower(), v) for k, v in envs.parse_overrides(text, "set").items()}
 
 
 def figure(results: list[dict], out: str) -> None:

@@ -127,6 +127,8 @@ class TrainConfig:
         for f in dataclasses.fields(self):  # inf and nan pass every range check, and JSON cannot hold them
             if f.type == "float":
                 check(math.isfinite(getattr(self, f.name)), f.name, getattr(self, f.name), "a finite number")
+            if f.type == "bool":  # a string such as "False" would pass every truth test
+                check(isinstance(getattr(self, f.name), bool), f.name, getattr(self, f.name), "true or false")
         check(self.iterations >= 1, "iterations", self.iterations, "an integer >= 1")
         check(self.num_envs >= 1, "num_envs", self.num_envs, "an integer >= 1")
         check(self.relabel in RELABELS, "relabel", self.relabel, "one of " + ", ".join(RELABELS))
