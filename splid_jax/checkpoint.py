@@ -36,11 +36,17 @@ def checkpoint_dir(run_dir: str | Path) -> Path:
 
 def _manager(directory: Path, *, read_only: bool, max_to_keep: int = MAX_TO_KEEP) -> ocp.CheckpointManager:
     # Synchronous saves keep Ctrl-C handling simple: when save() returns, the step is on disk.
+    # One process saves and restores the whole state, also when a sweep spans several (splid_jax.multihost):
+    # orbax is told it works alone, else it waits at barriers for the others; it then leaves the mkdir to us.
+    if not read_only:
+        directory.mkdir(parents=True, exist_ok=True)
+    alone = ocp.options.MultiprocessingOptions(primary_host=jax.process_index(), active_processes={jax.process_index()})
     options = ocp.CheckpointManagerOptions(
         max_to_keep=max_to_keep,
-        create=not read_only,
+        create=False,
         cleanup_tmp_directories=not read_only,
         enable_async_checkpointing=False,
+        multiprocessing_options=alone,
     )
     handlers = {
         _STATE: ocp.StandardCheckpointHandler(),
@@ -54,6 +60,13 @@ def _flat(tree: Any) -> dict[str, Any]:
     """Leaves keyed by orbax's own dotted names (``opt.0.mu.w``), the keys its metadata uses."""
     flat = ocp.tree.to_flat_dict(ocp.tree.serialize_tree(tree, keep_empty_nodes=False))
     return {".".join(str(k) for k in path): leaf for path, leaf in flat.items()}
+
+
+def on_host(state: Any) -> Any:
+    """``state`` with host arrays, as orbax stores it (nested dicts of the same key names): what one
+    process saves of arrays that others computed. Through a custom node such as brax's UInt64 host
+    arrays turn back into device arrays, which orbax refuses to save when a run spans processes."""
+    return jax.tree.map(np.asarray, ocp.tree.serialize_tree(jax.device_get(state), keep_empty_nodes=True))
 
 
 def _crc(x: Any) -> int:

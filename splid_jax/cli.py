@@ -161,6 +161,23 @@ def use_compile_cache(path: str) -> None:
         jax.config.update("jax_compilation_cache_dir", path)
 
 
+def add_launch_flags(parser: argparse.ArgumentParser) -> None:
+    """How this process joins the others of a run over several processes or hosts: launch options,
+    not settings, so they change nothing a run computes and a resume may give them anew."""
+    group = parser.add_argument_group("several processes (one sweep over several hosts)")
+    group.add_argument("--coordinator", metavar="HOST:PORT", help="address of process 0, which every process reaches")
+    group.add_argument("--num-processes", type=int, metavar="N", help="processes of the run (default: 1)")
+    group.add_argument("--process-id", type=int, metavar="I", help="this process's index in [0, N); 0 writes the run")
+
+
+def start_processes(ns: argparse.Namespace) -> None:
+    """Joins the run's processes (``jax.distributed``) before any other JAX use; bad launch options
+    raise ``InvalidConfig`` before anything waits for a peer."""
+    from splid_jax import multihost
+
+    multihost.start(multihost.launch(ns.coordinator, ns.num_processes, ns.process_id))
+
+
 def exit_with(code: int) -> None:
     """Exit with ``code``; after a signal (130, 143) at once: the chunk or compilation the signal cut
     short may still run in a worker thread."""

@@ -29,7 +29,7 @@ import numpy as np
 
 import envs
 from envs.base import InvalidConfig
-from splid_jax import checkpoint, devices, progress
+from splid_jax import checkpoint, devices, multihost, progress
 from splid_jax.algorithm import EVAL_KEYS, Algorithm
 from splid_jax.config import TrainConfig
 
@@ -118,10 +118,14 @@ def identity(cfg: TrainConfig) -> dict:
 class _Signals:
     """SIGINT and SIGTERM only set a flag, read between steps. Blocking work (tracing, compiling, a
     chunk) runs in a daemon thread while the main thread waits in short slices, so a signal is seen
-    within a fraction of a second instead of after a compilation of minutes."""
+    within a fraction of a second instead of after a compilation of minutes.
+
+    Over several processes a signal is acted on only after a chunk, where every process learns of it
+    (``agree``): all then stop at the same iteration and take part in its checkpoint."""
 
     def __init__(self):
         self.signum: int | None = None
+        self.shared = jax.process_count() > 1
         self._previous: dict[int, Any] = {}
 
     def __enter__(self) -> _Signals:
@@ -139,8 +143,16 @@ class _Signals:
             self.signum = signum
 
     def check(self) -> None:
-        if self.signum is not None:
+        if self.signum is not None and not self.shared:
             raise Interrupted(self.signum)
+
+    def agree(self) -> None:
+        """``check``, after every process has told the others of the signal it got, if any."""
+        if self.shared:
+            self.signum = multihost.any_of(self.signum or 0) or None
+            if self.signum is not None:
+                raise Interrupted(self.signum)
+        self.check()
 
     def wait(self, fn: Callable[[], Any]) -> Any:
         """``fn()`` in a daemon thread; raises ``Interrupted`` as soon as a signal came (the thread is
@@ -367,7 +379,8 @@ def run(
     """Train to ``cfg.iterations``; returns the last metrics record of each lane (one for a run).
 
     ``members``: the configs of a sweep's members (each its own seed, run_dir and traced settings),
-    trained in lock-step as one vmapped program with checkpoints under ``cfg.run_dir``."""
+    trained in lock-step as one vmapped program with checkpoints under ``cfg.run_dir``. Over several
+    processes every process calls it alike and each returns the records; only process 0 writes and shows."""
     env = env or make_env(cfg.env, **cfg.env_overrides())
     place = placement(cfg, None if members is None else len(members), algo)
     split_envs = place.axis == devices.ENVS and place.count > 1
@@ -378,7 +391,9 @@ def run(
 
 class _Loop:
     def __init__(self, cfg, env, algo, members, place: devices.Placement, signals: _Signals, quiet: bool):
-        self.cfg, self.env, self.algo, self.signals, self.quiet = cfg, env, algo, signals, quiet
+        self.cfg, self.env, self.algo, self.signals = cfg, env, algo, signals
+        self.writes = multihost.is_first()  # the others compute their share and leave the run directory alone
+        self.quiet = quiet or not self.writes
         self.stacked = members is not None
         self.lanes = list(members) if self.stacked else [cfg]
         self.place = place
@@ -397,11 +412,13 @@ class _Loop:
 
     def run(self, resume: bool) -> list[dict]:
         cfg = self.cfg
-        step = check_run_dir(cfg, resume)
+        step = multihost.from_first(lambda: check_run_dir(cfg, resume))
         if resume and step == cfg.iterations:
             self.show(f"{cfg.run_dir}: already complete ({step} iterations); nothing to do")
-            return [(read_metrics(os.path.join(m.run_dir, METRICS)) or [{}])[-1] for m in self.lanes]
-        check_writable(cfg.run_dir)
+            return multihost.from_first(
+                lambda: [(read_metrics(os.path.join(m.run_dir, METRICS)) or [{}])[-1] for m in self.lanes]
+            )
+        multihost.from_first(lambda: check_writable(cfg.run_dir))
         self.saved_at = step
         try:
             return self.start(resume, step)
@@ -441,7 +458,8 @@ class _Loop:
         check_memory(2 * state_bytes + largest, f"state {_gb(state_bytes)} twice, largest intermediate {_gb(largest)}",
                      self.device, cfg, len(self.lanes))  # fmt: skip
 
-        on = f"{place.count} devices split by {place.axis}" if place.count > 1 else self.device.platform
+        processes = f" of {jax.process_count()} processes" if jax.process_count() > 1 else ""
+        on = f"{place.count} devices{processes} split by {place.axis}" if place.count > 1 else self.device.platform
         self.show(f"splid_jax: algo={algo.name} env={cfg.env} device={on}"
                   + (f" members={len(self.lanes)}" if self.stacked else ""))  # fmt: skip
         self.show(f"compiling the training program ({compile_hint(self.env)}; "
@@ -464,12 +482,12 @@ class _Loop:
             state = _canonical(self.signals.wait(lambda: jax.jit(init)(keys)), sharding)
             state = state if groups is None else groups.split(state)
             select_steps, wall_before = [0] * len(self.lanes), 0.0
-            for lane in self.lanes:
+            for lane in self.lanes if self.writes else ():
                 os.makedirs(lane.run_dir, exist_ok=True)
                 _write_atomic(os.path.join(lane.run_dir, METRICS), "")
-        for lane in self.lanes:
+        for lane in self.lanes if self.writes else ():
             _write_json(os.path.join(lane.run_dir, "config.json"), {**lane.to_json(), "devices": place.record()})
-        if self.stacked:
+        if self.stacked and self.writes:
             named = [{**m.to_json(), "run_dir": os.path.basename(m.run_dir)} for m in self.lanes]
             _write_json(os.path.join(cfg.run_dir, SWEEP), {"config": cfg.to_json(), "members": named})
         self.groups = groups
@@ -477,11 +495,16 @@ class _Loop:
 
     def restore(self, like):
         cfg = self.cfg
-        step, state, meta = self.signals.wait(lambda: checkpoint.restore(cfg.run_dir, like, expect_meta=self.meta()))
-        for lane in self.lanes:  # lines written past the checkpoint are dropped, as is a torn last line
-            path = os.path.join(lane.run_dir, METRICS)
-            kept = [r for r in read_metrics(path) if r["iteration"] <= step]
-            _write_atomic(path, "".join(json.dumps(r) + "\n" for r in kept))
+
+        def read():
+            step, state, meta = checkpoint.restore(cfg.run_dir, like, expect_meta=self.meta())
+            for lane in self.lanes:  # lines written past the checkpoint are dropped, as is a torn last line
+                path = os.path.join(lane.run_dir, METRICS)
+                kept = [r for r in read_metrics(path) if r["iteration"] <= step]
+                _write_atomic(path, "".join(json.dumps(r) + "\n" for r in kept))
+            return step, state, meta
+
+        step, state, meta = self.signals.wait(lambda: multihost.from_first(read))
         self.show(f"resumed {cfg.run_dir} at iteration {step}")
         if self.stacked and self.place.axis == devices.MEMBERS and self.place.count > 1:
             state = _Groups(self.place, len(self.lanes)).split(state)
@@ -494,7 +517,9 @@ class _Loop:
             return
         meta = {**self.meta(), "wall_s": wall_s, "select_steps": select_steps}
         whole = state if self.groups is None else self.groups.join(state)
-        checkpoint.save(self.cfg.run_dir, iteration, whole, meta)
+        if self.writes:
+            checkpoint.save(self.cfg.run_dir, iteration, whole, meta)
+        multihost.barrier("checkpoint saved")  # before a stop lets any process exit
         self.saved_at = iteration
 
     def train(self, compiled, state, hyper, iteration: int, select_steps: list[int], wall_before: float):
@@ -533,7 +558,7 @@ class _Loop:
                     )  # fmt: skip
                     for i in range(len(lanes))
                 ]
-                for lane, rec in zip(lanes, last, strict=True):  # a line past the checkpoint is dropped on resume
+                for lane, rec in zip(lanes, last, strict=True) if self.writes else ():  # past a checkpoint: dropped
                     with open(os.path.join(lane.run_dir, METRICS), "a") as fh:
                         fh.write(json.dumps(rec) + "\n")
                 state, iteration, select_steps, chunks = new_state, done, totals, chunks + 1
@@ -544,7 +569,7 @@ class _Loop:
                               cfg.iterations))  # fmt: skip
                 if iteration == cfg.iterations or (cfg.checkpoint_every and chunks % cfg.checkpoint_every == 0):
                     self.save(state, iteration, select_steps, wall())
-                self.signals.check()
+                self.signals.agree()
         except Interrupted as stop:
             self.save(state, iteration, select_steps, wall())
             name = signal.Signals(stop.signum).name
@@ -562,11 +587,14 @@ class _Groups:
     vmapped chunk as one device runs it). Dispatch is asynchronous, so the devices run at once; a
     group computes exactly what a sweep of its members computes on one device, and no collective
     or SPMD partitioning is involved (XLA:GPU failed to compile MJX chunks partitioned by
-    ``shard_map``, and XLA:CPU under jaxlib 0.10 can hang in multi-device programs)."""
+    ``shard_map``, and XLA:CPU under jaxlib 0.10 can hang in multi-device programs). Over several
+    processes each runs the groups of its own devices, and the members' metrics and checkpointed
+    state are gathered between chunks (``multihost.concat``)."""
 
     def __init__(self, place: devices.Placement, members: int):
-        self.devices = list(place.mesh.devices.flat)
-        self.size = members // len(self.devices)
+        every = list(place.mesh.devices.flat)
+        self.size = members // len(every)
+        self.devices = {i: d for i, d in enumerate(every) if d.process_index == jax.process_index()}  # group: device
 
     def first(self, tree):
         return jax.tree.map(lambda x: _slice(x, 0, self.size), tree)
@@ -576,25 +604,30 @@ class _Groups:
         return jax.tree.map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=sharding), tree)
 
     def split(self, tree) -> tuple:
+        """This process's groups of the whole sweep's ``tree``."""
         host = jax.device_get(tree)
         return tuple(
             jax.device_put(jax.tree.map(lambda x, i=i: _slice(x, i * self.size, self.size), host), device)
-            for i, device in enumerate(self.devices)
+            for i, device in self.devices.items()
         )
 
     def join(self, groups: tuple):
-        return jax.tree.map(lambda *xs: np.concatenate([np.asarray(x) for x in xs]), *jax.device_get(groups))
+        """The whole sweep's state to checkpoint, on the host of every process, from this process's groups."""
+        return checkpoint.on_host(multihost.concat(_concat(jax.device_get(groups))))
 
     def compile(self, first, compile_on, signals: _Signals):
-        rest = [signals.wait(lambda d=d: compile_on(d)) for d in self.devices[1:]]
+        rest = [signals.wait(lambda d=d: compile_on(d)) for d in list(self.devices.values())[1:]]
         programs = [first, *rest]
 
         def run(states: tuple, hypers: tuple):
             outs = [p(s, h) for p, s, h in zip(programs, states, hypers, strict=True)]  # dispatched at once
-            metrics = jax.tree.map(lambda *m: np.concatenate([np.asarray(x) for x in m]), *[o[1] for o in outs])
-            return tuple(o[0] for o in outs), metrics
+            return tuple(o[0] for o in outs), multihost.concat(_concat([o[1] for o in outs]))
 
         return run
+
+
+def _concat(groups):
+    return jax.tree.map(lambda *xs: np.concatenate([np.asarray(x) for x in xs]), *groups)
 
 
 def _slice(x, start: int, size: int):

@@ -22,13 +22,15 @@ import re  # noqa: E402
 import sys  # noqa: E402
 
 from envs.base import InvalidConfig, check  # noqa: E402
-from splid_jax import checkpoint, loop, plot, progress  # noqa: E402
+from splid_jax import checkpoint, loop, multihost, plot, progress  # noqa: E402
 from splid_jax.cli import (  # noqa: E402
     Parser,
     add_compile_cache_flag,
     add_config_flags,
+    add_launch_flags,
     explicit_values,
     refuse_unread,
+    start_processes,
     use_compile_cache,
 )
 from splid_jax.config import ALGO_DEFAULTS, TASK_DEFAULTS, TrainConfig  # noqa: E402
@@ -115,6 +117,7 @@ def build_parser() -> Parser:
     parser.add_argument("--no-plot", action="store_true", help="skip the grid figure")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_compile_cache_flag(parser)
+    add_launch_flags(parser)
     return parser
 
 
@@ -141,9 +144,10 @@ def main(argv: list[str] | None = None) -> int:
     ns = parser.parse_args(_join_negative(sys.argv[1:] if argv is None else argv))
     use_compile_cache(ns.compile_cache)
     try:
+        start_processes(ns)
         given = explicit_values(TrainConfig, ns)
-        if ns.resume:
-            cfg, lanes = resume_configs(ns.resume, given)
+        if ns.resume:  # its sweep.json: process 0's
+            cfg, lanes = multihost.from_first(lambda: resume_configs(ns.resume, given))
         else:
             refuse_unread(given, given.get("algo", "splid"))
             given.setdefault("run_dir", os.path.join("runs", f"sweep-{given.get('env', 'point')}"))
@@ -161,7 +165,7 @@ def main(argv: list[str] | None = None) -> int:
     except (RunStopped, checkpoint.CheckpointError) as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 3
-    if not ns.no_plot:
+    if not ns.no_plot and multihost.is_first():
         out = os.path.join(cfg.run_dir, "grid.png")
         plot.main([m.run_dir for m in lanes] + ["--group", "--out", out])
         progress.show(f"figure: {out}", ns.quiet)

@@ -19,13 +19,15 @@ import sys  # noqa: E402
 
 import envs  # noqa: E402
 from envs.base import InvalidConfig  # noqa: E402
-from splid_jax import checkpoint, loop, progress  # noqa: E402
+from splid_jax import checkpoint, loop, multihost, progress  # noqa: E402
 from splid_jax.cli import (  # noqa: E402
     Parser,
     add_compile_cache_flag,
     add_config_flags,
+    add_launch_flags,
     explicit_values,
     refuse_unread,
+    start_processes,
     use_compile_cache,
 )
 from splid_jax.config import ALGO_DEFAULTS, PROVENANCE, TASK_DEFAULTS, TrainConfig  # noqa: E402
@@ -51,6 +53,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--resume", metavar="RUN_DIR", help="continue the run saved in RUN_DIR (its config.json)")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_compile_cache_flag(parser)
+    add_launch_flags(parser)
     return parser
 
 
@@ -83,7 +86,8 @@ def main(argv: list[str] | None = None) -> int:
     ns = parser.parse_args(argv)
     use_compile_cache(ns.compile_cache)
     try:
-        cfg, resume = config_from_cli(ns)
+        start_processes(ns)
+        cfg, resume = multihost.from_first(lambda: config_from_cli(ns))  # its --resume directory: process 0's
         env = make_env(cfg.env, **cfg.env_overrides())
         cfg.check_env(env)
         rec = run(cfg, env, resume=resume, quiet=ns.quiet)
