@@ -46,7 +46,21 @@ def traces(env, trainer: Trainer, pstate, key, episodes: int) -> dict:
     hit = jnp.any(succ, axis=0)
     speed_at_hit = jnp.where(hit, jnp.take_along_axis(speed, first[None], axis=0)[0], jnp.nan)
     stays = hit & jnp.all(jnp.where(jnp.arange(env.episode_length)[:, None] >= first[None], succ, True), axis=0)
+    # goals above where the object rests (PickAndPlace's half in the air) against goals on the table
+    air = start.desired_goal[:, -1] - start.achieved_goal[:, -1] > 0.01
+    if start.desired_goal.shape[-1] != 3:  # planar goals have no height
+        air = jnp.zeros_like(air)
+    final = succ[-1]
+
+    def share(x, where):
+        return jnp.sum(x & where) / jnp.maximum(jnp.sum(where), 1)
+
     return {
+        "air_goal_share": jnp.mean(air),
+        "hit_air": share(hit, air),
+        "hit_table": share(hit, ~air),
+        "final_air": share(final, air),
+        "final_table": share(final, ~air),
         "success_per_step": jnp.mean(succ, axis=1),
         "distance_median_per_step": jnp.median(dist, axis=1),
         "speed_at_first_hit_median": jnp.nanmedian(speed_at_hit),
@@ -170,7 +184,11 @@ def main() -> None:
         t = r["traces"]
         print(
             f"{r['fields']}: hit {np.mean(t['hit']):.3f} stayed {np.mean(t['hit_and_stayed']):.3f} "
-            f"speed at first hit {np.mean(t['speed_at_first_hit_median']):.3f} m/s; compile {r['compile_s']:.1f}s",
+            f"speed at first hit {np.mean(t['speed_at_first_hit_median']):.3f} m/s; goals in the air "
+            f"{np.mean(t['air_goal_share']):.2f} (hit {np.mean(t['hit_air']):.3f}, "
+            f"final {np.mean(t['final_air']):.3f}), "
+            f"on the table hit {np.mean(t['hit_table']):.3f} final {np.mean(t['final_table']):.3f}; "
+            f"compile {r['compile_s']:.1f}s",
             flush=True,
         )
     figure(results, os.path.join(a.out, f"{a.env}-traces.png"))
