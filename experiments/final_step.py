@@ -25,7 +25,7 @@ import numpy as np
 
 import envs
 from envs.base import step_batch
-from splid_jax.config import TrainConfig
+from splid_jax.config import TrainConfig, typed_fields
 from splid_jax.her import HER, HerConfig
 from splid_jax.trainer import Trainer
 
@@ -71,8 +71,9 @@ def traces(env, trainer: Trainer, pstate, key, episodes: int) -> dict:
 
 def run_arm(env_name: str, seeds: int, base: dict, fields: dict, trace_episodes: int) -> dict:
     merged = {**base, **fields}
-    her = {k[4:]: v for k, v in merged.items() if k.startswith("her_")}  # HerConfig fields, e.g. her_batch_size
-    cfg = TrainConfig(env=env_name, **{k: v for k, v in merged.items() if not k.startswith("her_")})
+    her = typed_fields(HerConfig, {k[4:]: v for k, v in merged.items() if k.startswith("her_")}, "set.her")
+    train = typed_fields(TrainConfig, {k: v for k, v in merged.items() if not k.startswith("her_")}, "set")
+    cfg = TrainConfig(env=env_name, **train)
     with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
         env = envs.make(cfg.env, **cfg.env_overrides())
     trainer = HER(env, cfg, HerConfig(**her)) if cfg.algo == "her" else Trainer(env, cfg)
@@ -118,8 +119,8 @@ def run_arm(env_name: str, seeds: int, base: dict, fields: dict, trace_episodes:
 
 
 def parse_set(text: str) -> dict:
-    words = {"true": True, "false": False}
-    return {k: words.get(str(v).lower(), v) for k, v in envs.parse_overrides(text, "set").items()}
+    """An arm's fields as written (they name its file); typed when its configs are built."""
+    return envs.parse_overrides(text, "set")
 
 
 def figure(results: list[dict], out: str) -> None:

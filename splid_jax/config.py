@@ -212,12 +212,19 @@ def parse_options(cls, text: str, field: str, prefix: str):
         overrides = envs.parse_overrides(",".join(items), field)
     except InvalidConfig:
         raise InvalidConfig(field, text, f"KEY=VALUE[,KEY=VALUE...] with {prefix} fields as keys") from None
-    values = {}
-    for key, value in overrides.items():
+    return cls(**typed_fields(cls, overrides, prefix))
+
+
+def typed_fields(cls, values: dict[str, Any], prefix: str) -> dict[str, Any]:
+    """``values`` (as ``envs.parse_overrides`` reads them) as the declared types of ``cls``'s fields; an
+    unknown key or a value of another type fails naming ``prefix.KEY``."""
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    typed = {}
+    for key, value in values.items():
         where = f"{prefix}.{key}"
         check(key in fields, where, value, "one of the fields " + ", ".join(fields))
-        values[key] = _typed(where, str(fields[key].type), value)
-    return cls(**values)
+        typed[key] = _typed(where, str(fields[key].type), value)
+    return typed
 
 
 def _typed(where: str, kind: str, value):
