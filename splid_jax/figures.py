@@ -269,7 +269,7 @@ def describe(plans: Sequence[Plan]) -> dict:
 
 def train(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
     """Trains each method's sweep in turn (on ``resume``, those with a checkpoint from it), noting in
-    OUT/figure.json the seconds each took."""
+    OUT/figure.json the seconds each took over every call, a stopped one's included."""
     _write_json(os.path.join(out, SPEC), record)
     for method in record["methods"]:
         ran, run_dir = record["runs"][method], os.path.join(out, method)
@@ -283,10 +283,12 @@ def train(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
             quiet,
         )
         t0 = time.perf_counter()
-        env = loop.make_env(base.env, **base.env_overrides())
-        loop.run(base, env, members=lanes, resume=again, quiet=quiet)
-        ran["total_s"] = round(ran.get("total_s", 0.0) + time.perf_counter() - t0, 1)  # compilation included
-        _write_json(os.path.join(out, SPEC), record)
+        try:
+            env = loop.make_env(base.env, **base.env_overrides())
+            loop.run(base, env, members=lanes, resume=again, quiet=quiet)
+        finally:  # a stopped method's seconds count too, so a resumed figure's total is whole
+            ran["total_s"] = round(ran.get("total_s", 0.0) + time.perf_counter() - t0, 1)  # compilation included
+            _write_json(os.path.join(out, SPEC), record)
 
 
 def _write_json(path: str, obj) -> None:

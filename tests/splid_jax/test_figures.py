@@ -236,3 +236,21 @@ def test_fig8_and_fig9_draw_return_and_both_success_measures_of_splid_and_gcsl(t
     assert return_axis.get_ylim()[1] > 7  # its own scale, not the success panels' [0, 1]
     assert final_axis.get_ylim() == any_axis.get_ylim()
     assert fig._suptitle.get_text().startswith("Figures 8 and 9: SPLID against GCSL on point")
+
+
+def test_a_stopped_method_keeps_its_seconds_for_the_resumed_total(tmp_path, monkeypatch):
+    """A figure trained over several calls reports each method's time over all of them."""
+    out = tmp_path / "out"
+    calls = []
+
+    def stopped(*args, **kwargs):
+        calls.append(kwargs.get("resume"))
+        raise loop.Interrupted(15)
+
+    monkeypatch.setattr(loop, "run", stopped)
+    assert figures.main(["fig3", "--methods", "gcsl", "--out", str(out), *QUICK]) == 143
+    first = json.loads((out / "figure.json").read_text())["runs"]["gcsl"]["total_s"]
+    assert first >= 0
+    assert figures.main(["fig3", "--resume", "--out", str(out), "--quiet"]) == 143
+    assert json.loads((out / "figure.json").read_text())["runs"]["gcsl"]["total_s"] >= first
+    assert calls == [False, False]  # nothing was saved, so the second call starts the method afresh
