@@ -28,14 +28,19 @@ def parse_overrides(text: str, field: str = "env_options") -> dict:
         key, sep, value = (x.strip() for x in part.partition("="))
         if not sep or not key or not value:
             raise InvalidConfig(field, text, "KEY=VALUE[,KEY=VALUE...] with task fields as keys")
-        try:
-            overrides[key] = int(value)
-        except ValueError:
-            try:
-                overrides[key] = float(value)
-            except ValueError:
-                overrides[key] = value
+        overrides[key] = read_value(value)
     return overrides
+
+
+def read_value(text: str) -> int | float | str:
+    """A setting's text as an integer, else a float, else the word itself."""
+    try:
+        return int(text)
+    except ValueError:
+        try:
+            return float(text)
+        except ValueError:
+            return text
 
 
 def names() -> list[str]:
@@ -50,15 +55,26 @@ def task_class(name: str) -> type[GoalEnv]:
     return getattr(importlib.import_module(module), cls_name)
 
 
-def _as_field_type(where: str, kind: str, value):
-    """An override converted to its field's declared type, or an error naming the field: ``20.5`` is no
-    integer, ``big`` no number."""
+def typed_value(where: str, kind: str, value):
+    """A setting (as ``read_value`` reads it) as its field's declared type ``kind``, or one error naming
+    ``where``: ``20.5`` is no integer, ``big`` no number. A tuple of integers arrives with colons
+    between its widths (``64:64``), since commas separate the settings."""
+    if kind == "bool":
+        words = {"true": True, "1": True, "false": False, "0": False}
+        if str(value).lower() not in words:
+            raise InvalidConfig(where, value, "true or false")
+        return words[str(value).lower()]
+    if kind.startswith("tuple"):
+        try:
+            return tuple(int(w) for w in str(value).split(":"))
+        except ValueError:
+            raise InvalidConfig(where, str(value).replace(":", ","), "comma-separated integers, e.g. 64,64") from None
     if kind == "int":
-        if isinstance(value, int):
+        if isinstance(value, int) and not isinstance(value, bool):
             return value
         raise InvalidConfig(where, value, "an integer")
     if kind == "float":
-        if isinstance(value, int | float) and math.isfinite(value):
+        if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
             return float(value)
         raise InvalidConfig(where, value, "a finite number")
     if kind == "str":
@@ -76,8 +92,18 @@ def make(name: str, **overrides) -> GoalEnv:
         if key not in fields:
             raise InvalidConfig(f"{name}.{key}", value, "one of the fields " + ", ".join(sorted(fields)))
         kind = fields[key].type if isinstance(fields[key].type, str) else fields[key].type.__name__
-        typed[key] = _as_field_type(f"{name}.{key}", kind, value)
+        typed[key] = typed_value(f"{name}.{key}", kind, value)
     return cls(**typed)
 
 
-__all__ = ["GoalEnv", "InvalidConfig", "State", "make", "names", "parse_overrides", "task_class"]
+__all__ = [
+    "GoalEnv",
+    "InvalidConfig",
+    "State",
+    "make",
+    "names",
+    "parse_overrides",
+    "read_value",
+    "task_class",
+    "typed_value",
+]

@@ -223,26 +223,8 @@ def typed_fields(cls, values: dict[str, Any], prefix: str) -> dict[str, Any]:
     for key, value in values.items():
         where = f"{prefix}.{key}"
         check(key in fields, where, value, "one of the fields " + ", ".join(fields))
-        typed[key] = _typed(where, str(fields[key].type), value)
+        typed[key] = envs.typed_value(where, str(fields[key].type), value)
     return typed
-
-
-def _typed(where: str, kind: str, value):
-    if kind == "bool":
-        words = {"true": True, "1": True, "false": False, "0": False}
-        check(str(value).lower() in words, where, value, "true or false")
-        return words[str(value).lower()]
-    if kind.startswith("tuple"):
-        try:
-            return tuple(int(w) for w in str(value).split(":"))
-        except ValueError:
-            raise InvalidConfig(where, str(value).replace(":", ","), "comma-separated integers, e.g. 64,64") from None
-    if kind == "int":
-        check(isinstance(value, int), where, value, "an integer")
-    if kind == "float":
-        check(isinstance(value, int | float) and math.isfinite(value), where, value, "a finite number")
-        return float(value)
-    return str(value) if kind == "str" else value
 
 
 def option_fields(cls) -> str:

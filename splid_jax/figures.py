@@ -123,23 +123,6 @@ def parse_methods(text: str, allowed: Sequence[str]) -> tuple[str, ...]:
     return words
 
 
-def _convert(name: str, text: str, kind: str):
-    """A --set value as the field's type."""
-    try:
-        if kind == "bool":
-            check(text.lower() in ("true", "false", "1", "0"), name, text, "true or false")
-            return text.lower() in ("true", "1")
-        if kind == "tuple[int, ...]":
-            return tuple(int(w) for w in text.split(","))
-        if kind == "int":
-            return int(text)
-        if kind == "float":
-            return float(text)
-    except ValueError:
-        raise InvalidConfig(name, text, f"a value of type {kind}") from None
-    return text
-
-
 def parse_sets(items: Sequence[str], methods: Sequence[str]) -> dict[str | None, dict[str, Any]]:
     """``[METHOD.]FIELD=VALUE`` items as {None: fields for every method, METHOD: its own fields}."""
     types = {f.name: f.type for f in dataclasses.fields(TrainConfig)}
@@ -159,7 +142,12 @@ def parse_sets(items: Sequence[str], methods: Sequence[str]) -> dict[str | None,
         )
         algo = METHODS[method].fields["algo"] if method else None
         check(not algo or reads(algo, name), "set", item, f"a field that {method} reads")
-        out.setdefault(method or None, {})[name] = _convert(name, value, types[name])
+        kind = str(types[name])
+        if kind.startswith("tuple"):  # one field per --set, so its commas are the tuple's
+            value = value.replace(",", ":")
+        elif kind != "str":
+            value = envs.read_value(value)
+        out.setdefault(method or None, {})[name] = envs.typed_value(name, kind, value)
     return out
 
 

@@ -254,3 +254,15 @@ def test_a_stopped_method_keeps_its_seconds_for_the_resumed_total(tmp_path, monk
     assert figures.main(["fig3", "--resume", "--out", str(out), "--quiet"]) == 143
     assert json.loads((out / "figure.json").read_text())["runs"]["gcsl"]["total_s"] >= first
     assert calls == [False, False]  # nothing was saved, so the second call starts the method afresh
+
+
+def test_set_reads_each_value_as_its_field_declares_it():
+    sets = figures.parse_sets(
+        ["hidden=32,32", "select_radius=0.5", "gcsl.gcsl_relabel=future", "splid.normalise=false", "bc_steps=7"],
+        ("splid", "gcsl"),
+    )
+    assert sets[None] == {"hidden": (32, 32), "select_radius": 0.5, "bc_steps": 7}
+    assert sets["gcsl"] == {"gcsl_relabel": "future"} and sets["splid"] == {"normalise": False}
+    for item, field in (("hidden=32,x", "hidden"), ("bc_steps=2.5", "bc_steps"), ("normalise=maybe", "normalise")):
+        with pytest.raises(figures.InvalidConfig, match=f"invalid {field}="):
+            figures.parse_sets([item], ("splid",))
