@@ -22,6 +22,7 @@ import json  # noqa: E402
 import math  # noqa: E402
 import os  # noqa: E402
 import shlex  # noqa: E402
+import shutil  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 from collections.abc import Sequence  # noqa: E402
@@ -279,6 +280,44 @@ def train(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
             _write_json(os.path.join(out, SPEC), record)
 
 
+def merge(out: str, parts: Sequence[str], figure: str, command: str) -> dict:
+    """One figure from ``--methods`` subsets of it trained apart (other machines, calls or processes):
+    each part's method directories are copied into ``out`` (checkpoints too, so ``--resume`` continues
+    an unfinished one) and their records joined; the parts stay as they are."""
+    check(len(parts) >= 2, "merge", " ".join(parts), "two or more figure directories")
+    records = [load_record(p) for p in parts]
+    first = records[0]
+    check(first["figure"] == figure, "merge", parts[0], f"a {figure} directory")
+    for part, record in zip(parts, records, strict=True):
+        for key in ("figure", "env", "seeds", "budget_episodes"):
+            check(
+                record.get(key) == first.get(key),
+                "merge",
+                part,
+                f"a figure directory with the {key} of {parts[0]} ({first.get(key)!r})",
+            )
+    methods = [m for r in records for m in r["methods"]]
+    check(len(set(methods)) == len(methods), "merge", " ".join(parts), "directories that train distinct methods")
+    check_out(out)
+    os.makedirs(out, exist_ok=True)
+    for part, record in zip(parts, records, strict=True):
+        for method in record["methods"]:
+            if os.path.isdir(os.path.join(part, method)):
+                shutil.copytree(os.path.join(part, method), os.path.join(out, method))
+    order = SPECS[first["figure"]].methods
+    merged = {
+        **first,
+        "methods": sorted(methods, key=order.index),
+        "device": " + ".join(dict.fromkeys(r["device"] for r in records)),
+        "date": " + ".join(dict.fromkeys(r["date"] for r in records)),
+        "command": command,
+        "runs": {m: r["runs"][m] for r in records for m in r["methods"]},
+        "parts": [{k: r[k] for k in ("command", "device", "date", "methods")} for r in records],
+    }
+    _write_json(os.path.join(out, SPEC), merged)
+    return merged
+
+
 def _write_json(path: str, obj) -> None:
     tmp = path + ".tmp"
     with open(tmp, "w") as fh:
@@ -464,6 +503,8 @@ Each method is one vmapped sweep in OUT/METHOD/ (the sweep's checkpoints, one ru
 member); OUT/figure.json records the command, device, date and what each method ran; the PNG and the
 CSV (method, episodes, mean and standard error of each measure, seeds, wall-clock seconds of training
 without compilation, iterations and episodes each method ran) lie in OUT.
+A figure too long for one machine or call can be trained as --methods subsets, each in its own --out,
+and joined with --merge (fig3 --merge DIR1 DIR2 ... --out OUT).
 Exit codes: 0 done, 2 bad input (nothing trained), 3 a run stopped (NaN), 130 Ctrl-C, 143 SIGTERM
 (each method's newest state is kept; --resume continues)."""
 
@@ -516,6 +557,14 @@ def build_parser() -> Parser:
     )
     parser.add_argument("--replot", action="store_true", help="redraw the figure and CSV in --out from its runs")
     parser.add_argument("--resume", action="store_true", help="continue the figure in --out where its runs stopped")
+    parser.add_argument(
+        "--merge",
+        nargs="+",
+        default=None,
+        metavar="DIR",
+        help="fig3: join figure directories trained with distinct --methods (on other machines or in other "
+        "calls) into --out, a new directory, and draw them as one figure; the parts are copied, not moved",
+    )
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_compile_cache_flag(parser)
     return parser
@@ -548,7 +597,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     use_compile_cache(ns.compile_cache)
     try:
-        if ns.replot or ns.resume:
+        if ns.merge:
+            check(not (ns.replot or ns.resume), "merge", " ".join(ns.merge), "given without --replot or --resume")
+            check(ns.out is not None, "out", None, "the new directory --merge joins the parts into")
+            merge(out, ns.merge, ns.figure, shlex.join(["python", "-m", "splid_jax.figures", *argv]))
+        elif ns.replot or ns.resume:
             check(not (ns.replot and ns.resume), "replot", True, "given without --resume")
             if ns.resume:
                 train(out, load_record(out), ns.quiet, resume=True)

@@ -266,3 +266,37 @@ def test_set_reads_each_value_as_its_field_declares_it():
     for item, field in (("hidden=32,x", "hidden"), ("bc_steps=2.5", "bc_steps"), ("normalise=maybe", "normalise")):
         with pytest.raises(figures.InvalidConfig, match=f"invalid {field}="):
             figures.parse_sets([item], ("splid",))
+
+
+def test_merge_joins_subsets_trained_apart_into_one_figure(tmp_path, capsys):
+    a, b, out = tmp_path / "a", tmp_path / "b", tmp_path / "out"
+    fake_figure(a, "fig3", {"her": [({"seed": 0, "algo": "her"}, [0.2, 0.4])]})
+    fake_figure(b, "fig3", {
+        "splid": [({"seed": 0, "algo": "splid"}, [0.5, 0.9])],
+        "gcsl": [({"seed": 0, "algo": "gcsl", "gcsl_relabel": "final"}, [0.1, 0.1])],
+    })  # fmt: skip
+    (a / "her" / "s0" / "checkpoints").mkdir()
+    before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+    assert figures.main(["fig3", "--merge", str(a), str(b), "--out", str(out), "--quiet"]) == 0
+    assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file() and out not in p.parents} == before
+    record = json.loads((out / "figure.json").read_text())
+    assert record["methods"] == ["splid", "gcsl", "her"]  # the figure's legend order
+    assert set(record["runs"]) == {"splid", "gcsl", "her"} and len(record["parts"]) == 2
+    assert record["command"].startswith("python -m splid_jax.figures fig3 --merge")
+    assert (out / "her" / "s0" / "checkpoints").is_dir()  # --resume continues an unfinished part
+    assert {r["method"] for r in rows(out / "fig3-point.csv")} == {"splid", "gcsl", "her"}
+
+
+@pytest.mark.parametrize("clash", ["method", "budget", "figure"])
+def test_merge_refuses_parts_that_are_not_one_figure(tmp_path, capsys, clash):
+    a, b, out = tmp_path / "a", tmp_path / "b", tmp_path / "out"
+    fake_figure(a, "fig3", {"splid": [({"seed": 0, "algo": "splid"}, [0.5])]})
+    other = "splid" if clash == "method" else "gcsl"
+    record = fake_figure(b, "fig3", {other: [({"seed": 0, "algo": other}, [0.5])]})
+    if clash == "budget":
+        (b / "figure.json").write_text(json.dumps({**record, "budget_episodes": 320}))
+    args = ["fig6" if clash == "figure" else "fig3", "--merge", str(a), str(b), "--out", str(out)]
+    assert figures.main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "invalid merge=" in err
+    assert not out.exists()
