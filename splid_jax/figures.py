@@ -259,7 +259,7 @@ def describe(plans: Sequence[Plan]) -> dict:
 def train(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
     """Trains each method's sweep in turn (on ``resume``, those with a checkpoint from it), noting in
     OUT/figure.json the seconds each took over every call, a stopped one's included."""
-    _write_json(os.path.join(out, SPEC), record)
+    loop.write_json(os.path.join(out, SPEC), record)
     for method in record["methods"]:
         ran, run_dir = record["runs"][method], os.path.join(out, method)
         base = TrainConfig(**{**ran["config"], "run_dir": run_dir})
@@ -277,7 +277,7 @@ def train(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
             loop.run(base, env, members=lanes, resume=again, quiet=quiet)
         finally:  # a stopped method's seconds count too, so a resumed figure's total is whole
             ran["total_s"] = round(ran.get("total_s", 0.0) + time.perf_counter() - t0, 1)  # compilation included
-            _write_json(os.path.join(out, SPEC), record)
+            loop.write_json(os.path.join(out, SPEC), record)
 
 
 def merge(out: str, parts: Sequence[str], figure: str, command: str) -> dict:
@@ -314,15 +314,8 @@ def merge(out: str, parts: Sequence[str], figure: str, command: str) -> dict:
         "runs": {m: r["runs"][m] for r in records for m in r["methods"]},
         "parts": [{k: r[k] for k in ("command", "device", "date", "methods")} for r in records],
     }
-    _write_json(os.path.join(out, SPEC), merged)
+    loop.write_json(os.path.join(out, SPEC), merged)
     return merged
-
-
-def _write_json(path: str, obj) -> None:
-    tmp = path + ".tmp"
-    with open(tmp, "w") as fh:
-        json.dump(obj, fh, indent=2)
-    os.replace(tmp, path)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -191,7 +191,8 @@ def _write_atomic(path: str, text: str) -> None:
     os.replace(tmp, path)
 
 
-def _write_json(path: str, obj) -> None:
+def write_json(path: str, obj) -> None:
+    """``obj`` as JSON at ``path``, replaced whole: a reader never sees half a file."""
     _write_atomic(path, json.dumps(obj, indent=2, allow_nan=False))
 
 
@@ -486,10 +487,10 @@ class _Loop:
                 os.makedirs(lane.run_dir, exist_ok=True)
                 _write_atomic(os.path.join(lane.run_dir, METRICS), "")
         for lane in self.lanes if self.writes else ():
-            _write_json(os.path.join(lane.run_dir, "config.json"), {**lane.to_json(), "devices": place.record()})
+            write_json(os.path.join(lane.run_dir, "config.json"), {**lane.to_json(), "devices": place.record()})
         if self.stacked and self.writes:
             named = [{**m.to_json(), "run_dir": os.path.basename(m.run_dir)} for m in self.lanes]
-            _write_json(os.path.join(cfg.run_dir, SWEEP), {"config": cfg.to_json(), "members": named})
+            write_json(os.path.join(cfg.run_dir, SWEEP), {"config": cfg.to_json(), "members": named})
         self.groups = groups
         return self.train(compiled, state, hyper, step or 0, select_steps, wall_before)
 
