@@ -256,12 +256,23 @@ def describe(plans: Sequence[Plan]) -> dict:
     }
 
 
+def sweeps(out: str, record: dict) -> list[tuple[str, dict, str]]:
+    """Each vmapped sweep of the figure as (method, its record, its directory): one per method in
+    OUT/METHOD/, or, in a Figure 4 or 5 merged from parts trained with distinct values, one per part in
+    OUT/METHOD/PART/."""
+    found = []
+    for method in record["methods"]:
+        ran = record["runs"][method]
+        for part in ran.get("parts", [ran]):
+            found.append((method, part, os.path.join(out, method, *([part["dir"]] if "dir" in part else []))))
+    return found
+
+
 def train(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
     """Trains each method's sweep in turn (on ``resume``, those with a checkpoint from it), noting in
     OUT/figure.json the seconds each took over every call, a stopped one's included."""
     loop.write_json(os.path.join(out, SPEC), record)
-    for method in record["methods"]:
-        ran, run_dir = record["runs"][method], os.path.join(out, method)
+    for method, ran, run_dir in sweeps(out, record):
         base = TrainConfig(**{**ran["config"], "run_dir": run_dir})
         lanes = [TrainConfig(**{**m, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in ran["members"]]
         again = resume and os.path.isdir(run_dir) and checkpoint.latest_step(run_dir) is not None
@@ -281,12 +292,14 @@ def train(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
 
 
 def merge(out: str, parts: Sequence[str], figure: str, command: str) -> dict:
-    """One figure from ``--methods`` subsets of it trained apart (other machines, calls or processes):
-    each part's method directories are copied into ``out`` (checkpoints too, so ``--resume`` continues
-    an unfinished one) and their records joined; the parts stay as they are."""
+    """One figure from parts of it trained apart (other machines, calls or processes): Figure 3's
+    ``--methods`` subsets, or Figure 4's or 5's ``--values`` subsets, each then a sweep of its own
+    shapes (an H sweep replays every member at its largest H's cost). Each part's method directories are
+    copied into ``out`` (checkpoints too, so ``--resume`` continues an unfinished one) and their records
+    joined; the parts stay as they are."""
     check(len(parts) >= 2, "merge", " ".join(parts), "two or more figure directories")
     records = [load_record(p) for p in parts]
-    first = records[0]
+    first, spec = records[0], SPECS[figure]
     check(first["figure"] == figure, "merge", parts[0], f"a {figure} directory")
     for part, record in zip(parts, records, strict=True):
         for key in ("figure", "env", "seeds", "budget_episodes"):
@@ -296,22 +309,36 @@ def merge(out: str, parts: Sequence[str], figure: str, command: str) -> dict:
                 part,
                 f"a figure directory with the {key} of {parts[0]} ({first.get(key)!r})",
             )
-    methods = [m for r in records for m in r["methods"]]
-    check(len(set(methods)) == len(methods), "merge", " ".join(parts), "directories that train distinct methods")
+        merged_before = any("parts" in ran for ran in record["runs"].values())
+        check(not merged_before, "merge", part, "a figure directory one command trained, not a merged one")
+    joined = " ".join(parts)
+    if spec.vary:
+        values = [m[spec.vary] for r in records for ran in r["runs"].values() for m in ran["members"]]
+        distinct = len(set(values)) * first["seeds"] == len(values)
+        check(distinct, "merge", joined, f"directories that train distinct {SHORT[spec.vary]} values")
+        methods = list(spec.methods)
+    else:
+        methods = [m for r in records for m in r["methods"]]
+        check(len(set(methods)) == len(methods), "merge", joined, "directories that train distinct methods")
     check_out(out)
     os.makedirs(out, exist_ok=True)
-    for part, record in zip(parts, records, strict=True):
+    runs: dict[str, dict] = {}
+    for i, (part, record) in enumerate(zip(parts, records, strict=True)):
         for method in record["methods"]:
+            sub = [f"part{i}"] if spec.vary else []
             if os.path.isdir(os.path.join(part, method)):
-                shutil.copytree(os.path.join(part, method), os.path.join(out, method))
-    order = SPECS[first["figure"]].methods
+                shutil.copytree(os.path.join(part, method), os.path.join(out, method, *sub))
+            if spec.vary:
+                runs.setdefault(method, {"parts": []})["parts"].append({**record["runs"][method], "dir": sub[0]})
+            else:
+                runs[method] = record["runs"][method]
     merged = {
         **first,
-        "methods": sorted(methods, key=order.index),
+        "methods": sorted(set(methods), key=spec.methods.index),
         "device": " + ".join(dict.fromkeys(r["device"] for r in records)),
         "date": " + ".join(dict.fromkeys(r["date"] for r in records)),
         "command": command,
-        "runs": {m: r["runs"][m] for r in records for m in r["methods"]},
+        "runs": runs,
         "parts": [{k: r[k] for k in ("command", "device", "date", "methods")} for r in records],
     }
     loop.write_json(os.path.join(out, SPEC), merged)
@@ -354,9 +381,10 @@ def load_series(out: str, record: dict) -> list[Series]:
     series = []
     for method in record["methods"]:
         runs = []
-        for member in record["runs"][method]["members"]:
+        for member_dir in [os.path.join(d, m["run_dir"]) for k, r, d in sweeps(out, record) if k == method
+                           for m in r["members"]]:  # fmt: skip
             try:
-                runs.append(plot.load_run(os.path.join(out, method, member["run_dir"])))
+                runs.append(plot.load_run(member_dir))
             except plot.PlotError:
                 continue  # not trained yet, or stopped before its first evaluation
         groups: dict[Any, list[plot.Run]] = {}
@@ -397,7 +425,10 @@ def write_csv(path: str, series: Sequence[Series], record: dict) -> None:
         writer = csv.writer(fh)
         writer.writerow(head)
         for s in series:
-            ran = record["runs"][s.method]
+            ran = next(
+                r for k, r, _ in sweeps("", record)
+                if k == s.method and (s.value is None or any(m.get(spec.vary) == s.value for m in r["members"]))
+            )  # fmt: skip
             for i in range(len(s.columns["iteration"])):
                 row: list[Any] = [s.method, *([s.value] if spec.vary else [])]
                 row += [int(s.columns["iteration"][i]), int(s.columns["episodes"][i])]
@@ -487,7 +518,8 @@ fig3: SPLID, GCSL, PCHID, HER, ES and SPLID without SELECT, success at any step 
       (GCSL pairs each step with the episode's last state, as the paper describes it: --set gcsl.gcsl_relabel=future
       for the original's future states).
 fig4: SPLID with H in 1, 2, 4, 8, 16 (one sweep; every member replays at the largest H's cost: on an H100
-      Slide's 25 members took 3.5x the time per member of Figure 5's at H = 8).
+      Slide's 25 members took 3.5x the time per member of Figure 5's at H = 8; --values subsets joined
+      with --merge run each at its own cost).
 fig5: SPLID with sigma in 0.25, 0.5, 1, 2 (one sweep).
 fig6: average return of SPLID with and without SELECT.
 fig8, fig9: SPLID and GCSL, average return (the paper's Figure 8) and success (Figure 9) from the same
@@ -497,8 +529,8 @@ Each method is one vmapped sweep in OUT/METHOD/ (the sweep's checkpoints, one ru
 member); OUT/figure.json records the command, device, date and what each method ran; the PNG and the
 CSV (method, episodes, mean and standard error of each measure, seeds, wall-clock seconds of training
 without compilation, iterations and episodes each method ran) lie in OUT.
-A figure too long for one machine or call can be trained as --methods subsets, each in its own --out,
-and joined with --merge (fig3 --merge DIR1 DIR2 ... --out OUT).
+A figure too long for one machine or call can be trained as --methods (fig3) or --values (fig4, fig5)
+subsets, each in its own --out, and joined with --merge (figN --merge DIR1 DIR2 ... --out OUT).
 Exit codes: 0 done, 2 bad input (nothing trained), 3 a run stopped (NaN), 130 Ctrl-C, 143 SIGTERM
 (each method's newest state is kept; --resume continues)."""
 
@@ -556,8 +588,9 @@ def build_parser() -> Parser:
         nargs="+",
         default=None,
         metavar="DIR",
-        help="fig3: join figure directories trained with distinct --methods (on other machines or in other "
-        "calls) into --out, a new directory, and draw them as one figure; the parts are copied, not moved",
+        help="join figure directories trained with distinct --methods (fig3) or --values (fig4, fig5; each "
+        "value then a sweep of its own shapes), on other machines or in other calls, into --out, a new "
+        "directory, and draw them as one figure; the parts are copied, not moved",
     )
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_compile_cache_flag(parser)

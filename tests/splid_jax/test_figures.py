@@ -300,3 +300,53 @@ def test_merge_refuses_parts_that_are_not_one_figure(tmp_path, capsys, clash):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "invalid merge=" in err
     assert not out.exists()
+
+
+def test_merge_joins_values_trained_apart_into_one_figure(tmp_path):
+    """Figure 4's values trained as parts of their own shapes draw as the one-sweep figure does."""
+    a, b, out = tmp_path / "a", tmp_path / "b", tmp_path / "out"
+    member = lambda s, h: ({"seed": s, "algo": "splid", "horizon": h}, [0.1, h / 16])  # noqa: E731
+    fake_figure(a, "fig4", {"splid": [member(s, 16) for s in (0, 1)]})
+    fake_figure(b, "fig4", {"splid": [member(s, h) for h in (2, 8) for s in (0, 1)]})
+    (a / "splid" / "checkpoints").mkdir()
+    before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+    assert figures.main(["fig4", "--merge", str(a), str(b), "--out", str(out), "--quiet"]) == 0
+    assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file() and out not in p.parents} == before
+    record = json.loads((out / "figure.json").read_text())
+    assert record["methods"] == ["splid"] and [p["dir"] for p in record["runs"]["splid"]["parts"]] == ["part0", "part1"]
+    assert (out / "splid" / "part0" / "checkpoints").is_dir()  # each part resumes in its own directory
+    table = rows(out / "fig4-point.csv")
+    assert sorted({int(r["horizon"]) for r in table}) == [2, 8, 16] and {r["seeds"] for r in table} == {"2"}
+    last = {int(r["horizon"]): float(r["eval_success_mean"]) for r in table if r["iteration"] == "10"}
+    assert last == pytest.approx({2: 2 / 16, 8: 8 / 16, 16: 1.0})
+
+
+def test_merge_refuses_a_value_in_two_parts(tmp_path, capsys):
+    a, b, out = tmp_path / "a", tmp_path / "b", tmp_path / "out"
+    fake_figure(a, "fig4", {"splid": [({"seed": 0, "algo": "splid", "horizon": 8}, [0.5])]})
+    fake_figure(b, "fig4", {"splid": [({"seed": 0, "algo": "splid", "horizon": h}, [0.5]) for h in (4, 8)]})
+    assert figures.main(["fig4", "--merge", str(a), str(b), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "distinct H values" in err
+    assert not out.exists()
+
+
+def test_a_merged_sweep_resumes_each_part_with_its_own_shapes(tmp_path, monkeypatch):
+    calls = []
+
+    def run(base, env, members, resume, quiet):
+        calls.append((base.run_dir, base.horizon, sorted({m.horizon for m in members}), len(members)))
+        for m in members:
+            assert m.run_dir.startswith(base.run_dir + os.sep)
+            if not os.path.isdir(m.run_dir):
+                fake_run(Path(m.run_dir), {"seed": m.seed, "algo": "splid", "horizon": m.horizon}, [0.5])
+
+    monkeypatch.setattr(loop, "run", run)
+    parts = [tmp_path / "h16", tmp_path / "h2-4"]
+    for part, values in zip(parts, ("16", "2,4"), strict=True):
+        assert figures.main(["fig4", "--values", values, "--out", str(part), *QUICK]) == 0
+    calls.clear()
+    out = tmp_path / "out"
+    assert figures.main(["fig4", "--merge", *map(str, parts), "--out", str(out), "--quiet"]) == 0
+    assert figures.main(["fig4", "--resume", "--out", str(out), "--quiet"]) == 0
+    assert calls == [(str(out / "splid" / "part0"), 16, [16], 2), (str(out / "splid" / "part1"), 4, [2, 4], 4)]
