@@ -256,15 +256,15 @@ def describe(plans: Sequence[Plan]) -> dict:
     }
 
 
-def sweeps(out: str, record: dict) -> list[tuple[str, dict, str]]:
-    """Each vmapped sweep of the figure as (method, its record, its directory): one per method in
-    OUT/METHOD/, or, in a Figure 4 or 5 merged from parts trained with distinct values, one per part in
-    OUT/METHOD/PART/."""
+def sweeps(record: dict) -> list[tuple[str, dict, str]]:
+    """Each vmapped sweep of the figure as (method, its record, its directory under OUT): one per method
+    in METHOD/, or, in a Figure 4 or 5 merged from parts trained with distinct values, one per part in
+    METHOD/PART/."""
     found = []
     for method in record["methods"]:
         ran = record["runs"][method]
         for part in ran.get("parts", [ran]):
-            found.append((method, part, os.path.join(out, method, *([part["dir"]] if "dir" in part else []))))
+            found.append((method, part, os.path.join(method, *([part["dir"]] if "dir" in part else []))))
     return found
 
 
@@ -272,7 +272,8 @@ def train(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
     """Trains each method's sweep in turn (on ``resume``, those with a checkpoint from it), noting in
     OUT/figure.json the seconds each took over every call, a stopped one's included."""
     loop.write_json(os.path.join(out, SPEC), record)
-    for method, ran, run_dir in sweeps(out, record):
+    for method, ran, sub in sweeps(record):
+        run_dir = os.path.join(out, sub)
         base = TrainConfig(**{**ran["config"], "run_dir": run_dir})
         lanes = [TrainConfig(**{**m, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in ran["members"]]
         again = resume and os.path.isdir(run_dir) and checkpoint.latest_step(run_dir) is not None
@@ -375,18 +376,18 @@ def load_record(out: str) -> dict:
 
 
 def load_series(out: str, record: dict) -> list[Series]:
-    """Each method's members from OUT/METHOD/, grouped by the swept value, over the evaluations
+    """Each method's members from its sweeps' directories, grouped by the swept value, over the evaluations
     every member of the group reached."""
     spec = SPECS[record["figure"]]
-    series = []
-    for method in record["methods"]:
-        runs = []
-        for member_dir in [os.path.join(d, m["run_dir"]) for k, r, d in sweeps(out, record) if k == method
-                           for m in r["members"]]:  # fmt: skip
+    runs_of: dict[str, list[plot.Run]] = {method: [] for method in record["methods"]}
+    for method, ran, sub in sweeps(record):
+        for member in ran["members"]:
             try:
-                runs.append(plot.load_run(member_dir))
+                runs_of[method].append(plot.load_run(os.path.join(out, sub, member["run_dir"])))
             except plot.PlotError:
                 continue  # not trained yet, or stopped before its first evaluation
+    series = []
+    for method, runs in runs_of.items():
         groups: dict[Any, list[plot.Run]] = {}
         for run in runs:
             groups.setdefault(run.config.get(spec.vary) if spec.vary else None, []).append(run)
@@ -421,14 +422,13 @@ def write_csv(path: str, series: Sequence[Series], record: dict) -> None:
     head = ["method", *([spec.vary] if spec.vary else []), "iteration", "episodes"]
     head += [f"{m}_{s}" for m in MEASURES for s in ("mean", "sem")]
     head += ["seeds", "wall_s", "episodes_per_iteration", "run_iterations", "run_episodes", "budget_episodes"]
+    # the sweep that trained each series: a merged Figure 4 or 5 holds one per part
+    ran_of = {(k, m.get(spec.vary) if spec.vary else None): r for k, r, _ in sweeps(record) for m in r["members"]}
     with open(path, "w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(head)
         for s in series:
-            ran = next(
-                r for k, r, _ in sweeps("", record)
-                if k == s.method and (s.value is None or any(m.get(spec.vary) == s.value for m in r["members"]))
-            )  # fmt: skip
+            ran = ran_of[s.method, s.value]
             for i in range(len(s.columns["iteration"])):
                 row: list[Any] = [s.method, *([s.value] if spec.vary else [])]
                 row += [int(s.columns["iteration"][i]), int(s.columns["episodes"][i])]
