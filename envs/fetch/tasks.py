@@ -31,7 +31,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs import mjx_solver_loop, small_cholesky
+from envs import small_cholesky
 from envs.base import GoalEnv, State, check, check_integer, flag_invalid
 from envs.fetch import models
 
@@ -39,7 +39,6 @@ MIN_OBJECT_DISTANCE = 0.1  # the object starts at least this far from the grippe
 _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4) ** 64 ~ 2e-7
 GOAL_LIFT_MAX = 0.45
 CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
-SOLVER_LOOPS = ("scan", "while")  # envs/mjx_solver_loop.py, or MJX's own while loop
 
 
 @struct.dataclass
@@ -92,7 +91,6 @@ class _FetchTask(GoalEnv):
     table: str = "plane"  # the table's collision shape: its top face as a plane, or the reference's box
     finger: str = "box"  # the closed finger block's collision shape (Push: box or capsule, see models.py)
     cholesky: str = "unrolled"  # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
-    solver_loop: str = "scan"  # MJX's Newton loop at a fixed trip count (envs/mjx_solver_loop.py) or MJX's "while"
     workspace: str = "arm"  # where the gripper target may go: the box and the reference arm's reach, or the box
     drive: str = "pd"  # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
 
@@ -121,8 +119,6 @@ class _FetchTask(GoalEnv):
         check(self.workspace in spaces, f"{n}.workspace", self.workspace, "one of " + ", ".join(spaces))
         check(self.drive in models.DRIVES, f"{n}.drive", self.drive, "one of " + ", ".join(models.DRIVES))
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
-        loops = SOLVER_LOOPS
-        check(self.solver_loop in loops, f"{n}.solver_loop", self.solver_loop, "one of " + ", ".join(loops))
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -285,8 +281,7 @@ class _FetchTask(GoalEnv):
         if self.drive == "weld":  # the constraint pulls the gripper to the mocap body, put at the target
             home = jnp.asarray(self.layout.grip_home, data.mocap_pos.dtype)
             data = data.replace(mocap_pos=data.mocap_pos.at[0].set(home + ctrl[0:3]))
-        fixed = mjx_solver_loop.fixed_solver_trips(self.iterations, self.solver_loop == "scan")
-        with small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"), fixed:
+        with small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"):
             data = jax.lax.fori_loop(0, self.substeps, lambda _, d: mjx.step(model, d), data)
         return Physics(
             qpos=data.qpos, qvel=data.qvel, ctrl=data.ctrl, time=data.time, qacc_warmstart=data.qacc_warmstart
