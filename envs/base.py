@@ -105,6 +105,11 @@ class GoalEnv(abc.ABC):
     def success(self, achieved: jax.Array, desired: jax.Array) -> jax.Array:
         """Whether ``achieved`` is within the task's threshold of ``desired`` (broadcasts)."""
 
+    def evaluation_task(self) -> GoalEnv:
+        """The task a policy is judged on: this one with every training-only option (a start
+        distribution that helps exploration) back at its standard setting."""
+        return self
+
     def reward_of(self, achieved: jax.Array, desired: jax.Array) -> jax.Array:
         """Sparse reward; the Fetch convention -(not success). Tasks may override."""
         return self.success(achieved, desired).astype(jnp.float32) - 1.0

@@ -11,6 +11,8 @@ from splid_jax.networks import Policy, PolicyState
 
 
 def evaluate(env: GoalEnv, policy: Policy, pstate: PolicyState, key: jax.Array, num_episodes: int) -> dict:
+    """From the task's standard starts, whatever training-only starts ``env`` explores from."""
+    env = env.evaluation_task()
     start = jax.vmap(env.reset)(jax.random.split(key, num_episodes))
 
     def one_step(state: State, _):

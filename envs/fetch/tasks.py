@@ -38,6 +38,7 @@ from envs.fetch import models
 MIN_OBJECT_DISTANCE = 0.1  # the object starts at least this far from the gripper in xy
 _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4) ** 64 ~ 2e-7
 GOAL_LIFT_MAX = 0.45
+GRASP_ABOVE_SITE = 0.01  # a grasped cube's centre above the grip site: inside the fingers' 6 cm height
 CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
 
 
@@ -93,6 +94,9 @@ class _FetchTask(GoalEnv):
     cholesky: str = "unrolled"  # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     workspace: str = "arm"  # where the gripper target may go: the box and the reference arm's reach, or the box
     drive: str = "pd"  # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
+    # Training only: this share of resets starts with the object between the closed fingers (PickAndPlace),
+    # HER 2017's protocol; evaluation_task() resets it to 0, so success is always measured from standard starts.
+    grasped_starts: float = 0.0
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -119,6 +123,9 @@ class _FetchTask(GoalEnv):
         check(self.workspace in spaces, f"{n}.workspace", self.workspace, "one of " + ", ".join(spaces))
         check(self.drive in models.DRIVES, f"{n}.drive", self.drive, "one of " + ", ".join(models.DRIVES))
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
+        grasp_range = "in [0, 1]" if not self.block_gripper else "0 (the fingers are locked on this task)"
+        ok = 0 <= self.grasped_starts <= 1 and (self.grasped_starts == 0 or not self.block_gripper)
+        check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -239,14 +246,22 @@ class _FetchTask(GoalEnv):
             goal = goal.at[2].add(jnp.where(jax.random.uniform(k_air) < 0.5, lift, 0.0))
         return goal
 
+    def evaluation_task(self) -> _FetchTask:
+        return dataclasses.replace(self, grasped_starts=0.0) if self.grasped_starts else self
+
     def reset(self, key: jax.Array) -> State:
         lay = self.layout
-        k_obj, k_goal = jax.random.split(key)
+        k_obj, k_goal, k_grasp = jax.random.split(key, 3)
         qpos = jnp.zeros(lay.nq)
         if self.has_object:
-            xy = self._object_xy(k_obj)
+            xyz = jnp.append(self._object_xy(k_obj), lay.object_rest_z)
             o = lay.object_q
-            qpos = qpos.at[o : o + 7].set(jnp.concatenate([xy, jnp.array([lay.object_rest_z, 1.0, 0.0, 0.0, 0.0])]))
+            if self.grasped_starts:
+                held = jax.random.uniform(k_grasp) < self.grasped_starts
+                xyz = jnp.where(held, jnp.asarray(lay.grip_home) + jnp.array([0.0, 0.0, GRASP_ABOVE_SITE]), xyz)
+                f = lay.finger_q  # each finger's inner face on a side of the cube; the zero control squeezes
+                qpos = qpos.at[f : f + 2].set(jnp.where(held, models.OBJECT_HALF, 0.0))
+            qpos = qpos.at[o : o + 7].set(jnp.concatenate([xyz, jnp.array([1.0, 0.0, 0.0, 0.0])]))
         phys = Physics(
             qpos=qpos,
             qvel=jnp.zeros(lay.nv),

@@ -382,3 +382,29 @@ def test_struck_slide_puck_stays_flat_on_the_table(fetch):
     assert np.abs(obs[..., 3:6] - np.asarray(s0.obs)[None, :, 3:6]).max() > 0.1  # the pucks were struck
     assert np.abs(obs[..., 11:13]).max() < 0.05  # roll and pitch: no tipping
     assert np.abs(obs[..., 5] - _env("slide").layout.object_rest_z).max() < 2e-3  # no lift
+
+
+def test_grasped_starts_put_the_cube_between_the_fingers_and_evaluation_starts_standard():
+    env = envs.make("pick_and_place", grasped_starts=1.0)
+    lay = env.layout
+    state = jax.vmap(env.reset)(jax.random.split(jax.random.PRNGKey(0), 16))
+    obj, grip, fingers = state.obs[:, 3:6], state.obs[:, 0:3], state.obs[:, 9:11]
+    np.testing.assert_allclose(obj - grip, np.tile([0.0, 0.0, tasks.GRASP_ABOVE_SITE], (16, 1)), atol=1e-6)
+    np.testing.assert_allclose(fingers, models.OBJECT_HALF, atol=1e-6)  # inner faces on the cube's sides
+    standard = env.evaluation_task()
+    assert standard.grasped_starts == 0.0 and standard.layout == lay
+    start = jax.vmap(standard.reset)(jax.random.split(jax.random.PRNGKey(0), 16))
+    np.testing.assert_allclose(start.obs[:, 5], lay.object_rest_z, atol=1e-6)  # every cube on the table
+    assert np.all(np.linalg.norm(start.obs[:, 3:5] - start.obs[:, 0:2], axis=-1) >= tasks.MIN_OBJECT_DISTANCE - 1e-6)
+
+
+def test_grasped_starts_mix_by_share_and_need_free_fingers():
+    env = envs.make("pick_and_place", grasped_starts=0.5)
+    state = jax.vmap(env.reset)(jax.random.split(jax.random.PRNGKey(1), 400))
+    held = np.asarray(state.obs[:, 5] > env.layout.object_rest_z + 0.05)
+    assert 0.4 < held.mean() < 0.6
+    assert envs.make("push").evaluation_task() == envs.make("push")
+    with pytest.raises(InvalidConfig, match="grasped_starts"):
+        envs.make("push", grasped_starts=0.5)
+    with pytest.raises(InvalidConfig, match="grasped_starts"):
+        envs.make("pick_and_place", grasped_starts=1.5)
