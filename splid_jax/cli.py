@@ -44,14 +44,14 @@ class Parser(argparse.ArgumentParser):
 
 def her_fields() -> str:
     from splid_jax.config import option_fields
-    from splid_jax.her import HerConfig
+    from splid_jax.learners.her.config import HerConfig
 
     return option_fields(HerConfig)
 
 
 def es_fields() -> str:
     from splid_jax.config import option_fields
-    from splid_jax.es import EsConfig
+    from splid_jax.learners.es import EsConfig
 
     return option_fields(EsConfig)
 
@@ -119,7 +119,7 @@ def add_config_flags(
 
 def refuse_unread(given: dict, algo: str) -> None:
     """A setting given on the command line that ``algo`` does not read is a mistake, not a no-op."""
-    from envs.base import InvalidConfig
+    from splid_jax.common.errors import InvalidConfig
     from splid_jax.config import NOT_READ
 
     for name in NOT_READ.get(algo, ()):
@@ -173,7 +173,7 @@ def add_launch_flags(parser: argparse.ArgumentParser) -> None:
 def start_processes(ns: argparse.Namespace) -> None:
     """Joins the run's processes (``jax.distributed``) before any other JAX use; bad launch options
     raise ``InvalidConfig`` before anything waits for a peer."""
-    from splid_jax import multihost
+    from splid_jax.runtime import multihost
 
     multihost.start(multihost.launch(ns.coordinator, ns.num_processes, ns.process_id))
 

@@ -9,7 +9,8 @@ import os
 from typing import Any
 
 import envs
-from envs.base import InvalidConfig, check
+from splid_jax.common.errors import InvalidConfig, check
+from splid_jax.common.values import parse_overrides, typed_value
 
 
 def _f(default, help: str, **kw):
@@ -164,17 +165,17 @@ class TrainConfig:
         self.env_overrides()  # the syntax; the fields themselves are checked where the task is built
 
     def env_overrides(self) -> dict[str, Any]:
-        return envs.parse_overrides(self.env_options)
+        return parse_overrides(self.env_options)
 
     def her_config(self):
-        """``her.HerConfig`` from ``her_options`` (imported here: her.py imports this module)."""
-        from splid_jax.her import HerConfig
+        """``HerConfig`` from ``her_options`` (imported here: the learners import this module)."""
+        from splid_jax.learners.her.config import HerConfig
 
         return parse_options(HerConfig, self.her_options, "her_options", "her")
 
     def es_config(self):
-        """``es.EsConfig`` from ``es_options``."""
-        from splid_jax.es import EsConfig
+        """``EsConfig`` from ``es_options``."""
+        from splid_jax.learners.es import EsConfig
 
         return parse_options(EsConfig, self.es_options, "es_options", "es")
 
@@ -198,7 +199,7 @@ class TrainConfig:
 
 def parse_options(cls, text: str, field: str, prefix: str):
     """A learner's config dataclass (``HerConfig``, ``EsConfig``) from ``KEY=VALUE[,KEY=VALUE...]``, read
-    by ``envs.parse_overrides``; a tuple field takes its widths comma-separated too (``hidden=64,64``).
+    by ``parse_overrides``; a tuple field takes its widths comma-separated too (``hidden=64,64``).
     A bad key or value fails naming ``prefix.KEY``."""
     fields = {f.name: f for f in dataclasses.fields(cls)}
     items: list[str] = []
@@ -209,21 +210,21 @@ def parse_options(cls, text: str, field: str, prefix: str):
         else:
             items.append(part)
     try:
-        overrides = envs.parse_overrides(",".join(items), field)
+        overrides = parse_overrides(",".join(items), field)
     except InvalidConfig:
         raise InvalidConfig(field, text, f"KEY=VALUE[,KEY=VALUE...] with {prefix} fields as keys") from None
     return cls(**typed_fields(cls, overrides, prefix))
 
 
 def typed_fields(cls, values: dict[str, Any], prefix: str) -> dict[str, Any]:
-    """``values`` (as ``envs.parse_overrides`` reads them) as the declared types of ``cls``'s fields; an
+    """``values`` (as ``parse_overrides`` reads them) as the declared types of ``cls``'s fields; an
     unknown key or a value of another type fails naming ``prefix.KEY``."""
     fields = {f.name: f for f in dataclasses.fields(cls)}
     typed = {}
     for key, value in values.items():
         where = f"{prefix}.{key}"
         check(key in fields, where, value, "one of the fields " + ", ".join(fields))
-        typed[key] = envs.typed_value(where, str(fields[key].type), value)
+        typed[key] = typed_value(where, str(fields[key].type), value)
     return typed
 
 

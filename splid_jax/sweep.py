@@ -1,6 +1,6 @@
 """``python -m splid_jax.sweep``: seeds x sigma x H as ONE compiled program.
 
-Every member is a lane of ``jax.vmap`` over the chunk function (``splid_jax.loop``): seeds differ by
+Every member is a lane of ``jax.vmap`` over the chunk function (``splid_jax.runtime.loop``): seeds differ by
 PRNG key, sigma and H by the traced hyper-parameters (H masks candidates up to the largest H of the
 grid), so a grid costs one compilation and runs in lock-step on the device. Each member writes its
 own config.json and metrics.jsonl under RUN_DIR/<member>; the members' stacked state is checkpointed
@@ -21,8 +21,7 @@ import os  # noqa: E402
 import re  # noqa: E402
 import sys  # noqa: E402
 
-from envs.base import InvalidConfig, check  # noqa: E402
-from splid_jax import checkpoint, loop, multihost, plot, progress  # noqa: E402
+from splid_jax import plot  # noqa: E402
 from splid_jax.cli import (  # noqa: E402
     Parser,
     add_compile_cache_flag,
@@ -33,8 +32,10 @@ from splid_jax.cli import (  # noqa: E402
     start_processes,
     use_compile_cache,
 )
+from splid_jax.common.errors import InvalidConfig, check  # noqa: E402
 from splid_jax.config import ALGO_DEFAULTS, TASK_DEFAULTS, TrainConfig  # noqa: E402
-from splid_jax.loop import RunStopped, make_env  # noqa: E402
+from splid_jax.runtime import checkpoint, loop, multihost, progress  # noqa: E402
+from splid_jax.runtime.loop import RunStopped, make_env  # noqa: E402
 
 
 @dataclasses.dataclass(frozen=True)

@@ -32,8 +32,9 @@ import jax.numpy as jnp
 from flax import struct
 
 from envs import small_cholesky
-from envs.base import GoalEnv, State, check, check_integer, flag_invalid
+from envs.base import GoalEnv, State, flag_invalid
 from envs.fetch import models
+from splid_jax.common.errors import check, check_integer
 
 MIN_OBJECT_DISTANCE = 0.1  # the object starts at least this far from the gripper in xy
 _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4) ** 64 ~ 2e-7

@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from splid_jax import figures, loop
+from splid_jax import figures
+from splid_jax.runtime import loop
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 QUICK = ["--quick", "--seeds", "2", "--episodes", "160", "--set", "eval_episodes=20", "--quiet"]

@@ -13,10 +13,10 @@ import jax
 import numpy as np
 import pytest
 
-from splid_jax import checkpoint
 from splid_jax.config import TrainConfig
+from splid_jax.learners.splid.trainer import Trainer
+from splid_jax.runtime import checkpoint
 from splid_jax.train import RunStopped, main, run
-from splid_jax.trainer import Trainer
 
 TINY = ["--env", "point", "--num-envs", "8", "--eval-episodes", "16", "--bc-steps", "40", "--batch-size", "64",
         "--hidden", "32,32", "--eval-every", "5"]  # fmt: skip
@@ -223,7 +223,7 @@ def test_env_options_build_the_task_the_run_trains_on(tmp_path):
 def test_resume_under_changed_task_defaults_fails_naming_the_option(tmp_path):
     # the same config both times; only the task itself differs, as after a change of its defaults
     import envs
-    from splid_jax.checkpoint import CheckpointError
+    from splid_jax.runtime.checkpoint import CheckpointError
 
     cfg = TrainConfig(env="point", num_envs=4, eval_episodes=4, bc_steps=2, batch_size=16, hidden=(8,),
                       eval_every=5, iterations=5, run_dir=str(tmp_path / "run"))  # fmt: skip
