@@ -27,9 +27,10 @@ import jax.numpy as jnp
 
 from splid_jax.config import TrainConfig
 from splid_jax.learners.imitation.explore import draws, rollout
+from splid_jax.learners.registry import make_algorithm
 from splid_jax.learners.splid.select import num_lanes, select
 from splid_jax.learners.splid.trainer import Trainer
-from splid_jax.runtime.loop import make_algorithm, make_env
+from splid_jax.runtime.loop import make_env
 
 
 def timed(fn, *args, repeats: int):

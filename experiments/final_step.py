@@ -25,8 +25,8 @@ import numpy as np
 
 import envs
 from envs.base import step_batch
-from splid_jax.common.values import parse_overrides
-from splid_jax.config import TrainConfig, typed_fields
+from splid_jax.common.values import parse_overrides, typed_fields
+from splid_jax.config import TrainConfig
 from splid_jax.learners.her.config import HerConfig
 from splid_jax.learners.her.learner import HER
 from splid_jax.learners.splid.trainer import Trainer

@@ -38,7 +38,8 @@ from splid_jax import plot  # noqa: E402
 from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache  # noqa: E402
 from splid_jax.common.errors import InvalidConfig, check  # noqa: E402
 from splid_jax.common.values import read_value, typed_value  # noqa: E402
-from splid_jax.config import NOT_READ, TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.learners import registry  # noqa: E402
 from splid_jax.runtime import checkpoint, loop, progress  # noqa: E402
 
 SPEC = "figure.json"  # the figure's command, device, date and what each method ran
@@ -104,7 +105,7 @@ QUICK_METHOD_FIELDS: dict[str, dict[str, Any]] = {
 def reads(algo: str, field: str) -> bool:
     """Whether ``algo`` reads a TrainConfig field, so that a setting given for every method skips
     those that do not (ES's num_envs is its population's episodes)."""
-    return field not in NOT_READ.get(algo, ()) and not (algo == "es" and field == "num_envs")
+    return registry.reads(algo, field)
 
 
 def default_budget(env: str) -> int:
@@ -205,7 +206,7 @@ def plan(
             made[options] = loop.make_env(env_name, **probe.env_overrides())
         env = made[options]
         probe.check_env(env)
-        per_iteration = loop.make_algorithm(probe, env).counters(1, 0)["episodes"]
+        per_iteration = registry.make_algorithm(probe, env).counters(1, 0)["episodes"]
         chunks = max(1, math.floor(budget / (per_iteration * probe.eval_every) + 0.5))  # nearest, half up
         # pchid_every left at 0 is resolved again, so PCHID's schedule follows the figure's iterations
         base = dataclasses.replace(
@@ -223,7 +224,7 @@ def plan(
         )
         for lane in lanes:
             lane.check_env(env)
-        loop.make_algorithm(base, env)  # the run's own settings
+        registry.make_algorithm(base, env)  # the run's own settings
         plans.append(Plan(name, base, lanes, per_iteration))
     return plans
 

@@ -33,7 +33,8 @@ from splid_jax.cli import (  # noqa: E402
     use_compile_cache,
 )
 from splid_jax.common.errors import InvalidConfig, check  # noqa: E402
-from splid_jax.config import ALGO_DEFAULTS, TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.learners import registry  # noqa: E402
 from splid_jax.runtime import checkpoint, loop, multihost, progress  # noqa: E402
 from splid_jax.runtime.loop import RunStopped, make_env  # noqa: E402
 
@@ -109,7 +110,7 @@ def build_parser() -> Parser:
     )
     # --sigmas and --horizons replace the single values
     add_config_flags(
-        parser, TrainConfig, TASK_DEFAULTS, exclude=frozenset({"sigma", "horizon"}), per_algo=ALGO_DEFAULTS
+        parser, TrainConfig, TASK_DEFAULTS, exclude=frozenset({"sigma", "horizon"}), per_algo=registry.task_defaults()
     )
     parser.add_argument("--seeds", type=int, default=4, help="seeds per grid point (default: 4)")
     parser.add_argument("--sigmas", default="1.0", help="comma-separated sigma values (default: 1.0)")

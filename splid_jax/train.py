@@ -29,7 +29,8 @@ from splid_jax.cli import (  # noqa: E402
     use_compile_cache,
 )
 from splid_jax.common.errors import InvalidConfig  # noqa: E402
-from splid_jax.config import ALGO_DEFAULTS, PROVENANCE, TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.config import PROVENANCE, TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.learners import registry  # noqa: E402
 from splid_jax.runtime import checkpoint, loop, multihost, progress  # noqa: E402
 from splid_jax.runtime.loop import MAY_CHANGE_ON_RESUME, RunStopped, env_settings, make_env  # noqa: E402
 
@@ -49,7 +50,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Exit codes: 0 done, 2 bad input (nothing written), 3 stopped on NaN or an unreadable checkpoint, "
         "130 Ctrl-C, 143 SIGTERM (both keep the newest whole state as a checkpoint for --resume).",
     )
-    add_config_flags(parser, TrainConfig, TASK_DEFAULTS, per_algo=ALGO_DEFAULTS)
+    add_config_flags(parser, TrainConfig, TASK_DEFAULTS, per_algo=registry.task_defaults())
     parser.add_argument("--resume", metavar="RUN_DIR", help="continue the run saved in RUN_DIR (its config.json)")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_compile_cache_flag(parser)

@@ -3,9 +3,11 @@ take them) read into values, and checked against a dataclass field's declared ty
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from typing import Any
 
-from splid_jax.common.errors import InvalidConfig
+from splid_jax.common.errors import InvalidConfig, check
 
 
 def parse_overrides(text: str, field: str = "env_options") -> dict:
@@ -56,3 +58,43 @@ def typed_value(where: str, kind: str, value):
     if kind == "str":
         return str(value)
     return value
+
+
+def parse_options(cls, text: str, field: str, prefix: str):
+    """A learner's config dataclass (``HerConfig``, ``EsConfig``) from ``KEY=VALUE[,KEY=VALUE...]``, read
+    by ``parse_overrides``; a tuple field takes its widths comma-separated too (``hidden=64,64``).
+    A bad key or value fails naming ``prefix.KEY``."""
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    items: list[str] = []
+    for part in (p.strip() for p in text.split(",")):
+        previous = items[-1].partition("=")[0].strip() if items else ""
+        if part and "=" not in part and previous in fields and str(fields[previous].type).startswith("tuple"):
+            items[-1] += ":" + part  # a further width of the tuple before
+        else:
+            items.append(part)
+    try:
+        overrides = parse_overrides(",".join(items), field)
+    except InvalidConfig:
+        raise InvalidConfig(field, text, f"KEY=VALUE[,KEY=VALUE...] with {prefix} fields as keys") from None
+    return cls(**typed_fields(cls, overrides, prefix))
+
+
+def typed_fields(cls, values: dict[str, Any], prefix: str) -> dict[str, Any]:
+    """``values`` (as ``parse_overrides`` reads them) as the declared types of ``cls``'s fields; an
+    unknown key or a value of another type fails naming ``prefix.KEY``."""
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    typed = {}
+    for key, value in values.items():
+        where = f"{prefix}.{key}"
+        check(key in fields, where, value, "one of the fields " + ", ".join(fields))
+        typed[key] = typed_value(where, str(fields[key].type), value)
+    return typed
+
+
+def option_fields(cls) -> str:
+    """``field=default (help); ...`` of a learner's config dataclass, for ``--help``."""
+    shown = []
+    for f in dataclasses.fields(cls):
+        default = ",".join(map(str, f.default)) if isinstance(f.default, tuple) else f.default
+        shown.append(f"{f.name}={default} ({f.metadata.get('help', '')})")
+    return "; ".join(shown)

@@ -30,6 +30,7 @@ import numpy as np
 import envs
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
+from splid_jax.learners import registry
 from splid_jax.learners.base import EVAL_KEYS, Algorithm
 from splid_jax.runtime import checkpoint, devices, multihost, progress
 
@@ -71,26 +72,6 @@ def env_settings(env: envs.GoalEnv) -> dict:
     return json.loads(json.dumps(env.settings()))
 
 
-SPLITS_ENVS = ("splid", "gcsl", "pchid")  # learners whose single run can split its envs across devices
-
-
-def make_algorithm(cfg: TrainConfig, env: envs.GoalEnv, mesh: jax.sharding.Mesh | None = None) -> Algorithm:
-    """The learner ``cfg.algo`` names, built for ``env`` (its envs split across ``mesh``)."""
-    if cfg.algo in SPLITS_ENVS:
-        from splid_jax.learners.splid.trainer import Trainer
-
-        return Trainer(env, cfg, mesh)
-    if cfg.algo == "her":
-        from splid_jax.learners.her.learner import HER
-
-        return HER(env, cfg, cfg.her_config())
-    if cfg.algo == "es":
-        from splid_jax.learners.es import ES
-
-        return ES(env, cfg, cfg.es_config())
-    raise InvalidConfig("algo", cfg.algo, "one of splid, gcsl, pchid, her, es")
-
-
 def placement(cfg: TrainConfig, members: int | None, algo: Algorithm | None = None) -> devices.Placement:
     """The devices a run (``members`` None) or a sweep of ``members`` uses (``cfg.num_devices``)."""
     if members is not None:
@@ -98,7 +79,7 @@ def placement(cfg: TrainConfig, members: int | None, algo: Algorithm | None = No
     if algo is not None:  # built by the caller: its own mesh, if any
         mesh = getattr(algo, "mesh", None)
         return devices.Placement(mesh, devices.ENVS) if mesh is not None else devices.place(1, 1, devices.ENVS)
-    if cfg.algo not in SPLITS_ENVS:
+    if not registry.get(cfg.algo).splits_envs:
         allowed = f"1 or 0 for a single {cfg.algo} run (a sweep of {cfg.algo} splits its members)"
         if cfg.num_devices > 1:
             raise InvalidConfig("num_devices", cfg.num_devices, allowed)
@@ -385,7 +366,7 @@ def run(
     env = env or make_env(cfg.env, **cfg.env_overrides())
     place = placement(cfg, None if members is None else len(members), algo)
     split_envs = place.axis == devices.ENVS and place.count > 1
-    algo = algo or make_algorithm(cfg, env, place.mesh if split_envs else None)
+    algo = algo or registry.make_algorithm(cfg, env, place.mesh if split_envs else None)
     with _Signals() as signals:
         return _Loop(cfg, env, algo, members, place, signals, quiet).run(resume)
 

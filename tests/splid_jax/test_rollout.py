@@ -207,7 +207,7 @@ def test_paths_figure_has_a_title_and_a_legend():
 def test_rollout_acts_as_the_evaluation_of_a_her_or_es_run(tmp_path, capsys, algo, options):
     """HER's actor and ES's search mean both sit at ``state.policy``; rollout rolls what the loop evaluates."""
     from splid_jax.common.evaluation import evaluate
-    from splid_jax.runtime.loop import make_algorithm
+    from splid_jax.learners.registry import make_algorithm
 
     run_dir = tmp_path / "run"
     cfg = TrainConfig(env="point", algo=algo, iterations=1, eval_every=1, hidden=(8,) if algo == "es" else None,

@@ -2,6 +2,7 @@
 any moment, NaN, corrupt and mismatched checkpoints. All on the point task, in subprocesses where a
 signal is real."""
 
+import dataclasses
 import json
 import os
 import signal
@@ -14,6 +15,7 @@ import numpy as np
 import pytest
 
 from splid_jax.config import TrainConfig
+from splid_jax.learners import registry
 from splid_jax.learners.splid.trainer import Trainer
 from splid_jax.runtime import checkpoint
 from splid_jax.train import RunStopped, main, run
@@ -113,13 +115,23 @@ def test_run_dir_that_is_a_file_is_refused(tmp_path, capsys):
 
 
 def test_help_documents_every_flag(capsys):
+    """Every field of the run config is a flag with its help line, and every field of a learner's own
+    settings is listed with its default under its learner's group."""
     with pytest.raises(SystemExit) as exc:
         main(["--help"])
     assert exc.value.code == 0
-    out = capsys.readouterr().out
-    for flag in ["--env", "--seed", "--iterations", "--num-envs", "--sigma", "--horizon", "--no-select", "--run-dir",
-                 "--resume"]:  # fmt: skip
-        assert flag in out
+    out = " ".join(capsys.readouterr().out.split())
+    for f in dataclasses.fields(TrainConfig):
+        flag = "--" + f.name.replace("_", "-")
+        help_start = " ".join(f.metadata["help"].split()[:4])
+        assert f"{flag} " in out and help_start in out, f.name
+    assert "--no-select" in out and "--resume" in out
+    for learner in registry.LEARNERS.values():
+        if learner.options is not None:
+            for f in dataclasses.fields(learner.settings):
+                default = ",".join(map(str, f.default)) if isinstance(f.default, tuple) else f.default
+                assert f"{f.name}={default} (" in out, f"{learner.name}.{f.name}"
+    assert "read only by splid, gcsl, pchid:" in out and "read only by her:" in out
 
 
 @pytest.mark.slow

@@ -5,10 +5,7 @@ from __future__ import annotations
 import dataclasses
 
 from splid_jax.common.errors import check
-
-
-def _f(default, help: str):
-    return dataclasses.field(default=default, metadata={"help": help})
+from splid_jax.common.fields import field
 
 
 @dataclasses.dataclass(frozen=True)
@@ -16,24 +13,24 @@ class HerConfig:
     """HER's own settings; defaults are OpenAI Baselines' (``baselines/her/experiment/config.py``).
     Normalised inputs are clipped to +-``networks.CLIP_NORMALISED`` (5, Baselines' norm_clip)."""
 
-    replay_k: int = _f(4, "future strategy: k relabelled goals per original one (relabel probability 1 - 1/(1+k))")
-    gamma: float = _f(0.98, "discount; Baselines uses 1 - 1/T, 0.98 for the 50-step episodes")
-    hidden: tuple[int, ...] = _f((256, 256, 256), "hidden layer widths of the actor and of the critic (ReLU)")
-    actor_lr: float = _f(1e-3, "Adam learning rate of the actor")
-    critic_lr: float = _f(1e-3, "Adam learning rate of the critic")
-    batch_size: int = _f(
+    replay_k: int = field(4, "future strategy: k relabelled goals per original one (relabel probability 1 - 1/(1+k))")
+    gamma: float = field(0.98, "discount; Baselines uses 1 - 1/T, 0.98 for the 50-step episodes")
+    hidden: tuple[int, ...] = field((256, 256, 256), "hidden layer widths of the actor and of the critic (ReLU)")
+    actor_lr: float = field(1e-3, "Adam learning rate of the actor")
+    critic_lr: float = field(1e-3, "Adam learning rate of the critic")
+    batch_size: int = field(
         2048,
         "transitions per gradient step: Baselines averages the gradients of 8 MPI workers' batches of 256, "
         "2048 in effect",
     )
-    buffer_transitions: int = _f(1_000_000, "replay capacity in transitions, stored as whole episodes (FIFO)")
-    n_batches: int = _f(40, "gradient steps per iteration (Baselines' n_batches per cycle)")
-    polyak: float = _f(0.95, "target = polyak * target + (1 - polyak) * online, once per iteration")
-    action_l2: float = _f(1.0, "weight of the actor's mean squared action penalty")
-    random_eps: float = _f(0.3, "exploration: probability of a uniformly random action")
-    noise_eps: float = _f(0.2, "exploration: std of the Gaussian noise added to the actor's action")
-    norm_eps: float = _f(0.01, "std floor of the observation and goal normaliser")
-    clip_obs: float = _f(200.0, "observations and goals are clipped to +-clip_obs before normalising")
+    buffer_transitions: int = field(1_000_000, "replay capacity in transitions, stored as whole episodes (FIFO)")
+    n_batches: int = field(40, "gradient steps per iteration (Baselines' n_batches per cycle)")
+    polyak: float = field(0.95, "target = polyak * target + (1 - polyak) * online, once per iteration")
+    action_l2: float = field(1.0, "weight of the actor's mean squared action penalty")
+    random_eps: float = field(0.3, "exploration: probability of a uniformly random action")
+    noise_eps: float = field(0.2, "exploration: std of the Gaussian noise added to the actor's action")
+    norm_eps: float = field(0.01, "std floor of the observation and goal normaliser")
+    clip_obs: float = field(200.0, "observations and goals are clipped to +-clip_obs before normalising")
 
     def __post_init__(self):
         object.__setattr__(self, "hidden", tuple(int(w) for w in self.hidden))

@@ -54,7 +54,7 @@ class HER:
     name = "her"
 
     def __init__(self, env: GoalEnv, cfg: TrainConfig, her: HerConfig | None = None):
-        her = HerConfig() if her is None else her
+        her = cfg.learner_config() if her is None else her
         T = env.episode_length
         check(
             her.buffer_transitions >= T,

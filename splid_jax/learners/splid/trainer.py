@@ -20,11 +20,10 @@ from splid_jax.learners.base import params_finite
 from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.bc import bc_epoch
 from splid_jax.learners.imitation.candidates import Candidates
+from splid_jax.learners.imitation.config import ImitationConfig
 from splid_jax.learners.imitation.explore import Seen, draws, rollout
 from splid_jax.learners.splid.select import select
 from splid_jax.runtime.devices import ENVS
-
-BC_ALGOS = ("splid", "gcsl", "pchid")
 
 
 @struct.dataclass
@@ -55,21 +54,22 @@ class Trainer:
     replicated, so the run computes what one device would, up to float rounding."""
 
     def __init__(self, env: GoalEnv, cfg: TrainConfig, mesh: Mesh | None = None):
-        check(cfg.algo in BC_ALGOS, "algo", cfg.algo, "one of " + ", ".join(BC_ALGOS) + " for this learner")
+        bc = cfg.learner_config()
+        check(isinstance(bc, ImitationConfig), "algo", cfg.algo, "a behaviour-cloning learner (splid, gcsl, pchid)")
         cfg.check_env(env)
-        self.env, self.cfg, self.name = env, cfg, cfg.algo
-        self.max_horizon = cfg.horizon  # shapes; a sweep's members mask larger h through Hyper.horizon
-        self.pchid_every = max(1, cfg.pchid_every)  # TrainConfig resolves 0 for pchid
+        self.env, self.cfg, self.bc, self.name = env, cfg, bc, cfg.algo
+        self.max_horizon = bc.horizon  # shapes; a sweep's members mask larger h through Hyper.horizon
+        self.pchid_every = max(1, bc.pchid_every)  # TrainConfig resolves 0 for pchid
         self.policy = make_policy(
             env.obs_size,
             env.goal_size,
             env.action_size,
-            cfg.hidden,
-            cfg.normalise,
-            achieved_start=env.achieved_goal_start if cfg.relative_goal else None,
+            bc.hidden,
+            bc.normalise,
+            achieved_start=env.achieved_goal_start if bc.relative_goal else None,
             goal_unit=env.success_distance,
         )
-        self.optimiser = optax.adam(cfg.learning_rate)
+        self.optimiser = optax.adam(bc.learning_rate)
         if mesh is not None:
             check(cfg.num_envs % mesh.size == 0, "num_envs", cfg.num_envs, f"a multiple of the {mesh.size} devices")
             # a model first built inside shard_map's trace would carry its manual axis into evaluation
@@ -78,19 +78,19 @@ class Trainer:
 
     def hyper(self, sigma: float | None = None, horizon: int | None = None) -> Hyper:
         return Hyper(
-            sigma=jnp.float32(self.cfg.sigma if sigma is None else sigma),
-            horizon=jnp.int32(self.cfg.horizon if horizon is None else horizon),
+            sigma=jnp.float32(self.bc.sigma if sigma is None else sigma),
+            horizon=jnp.int32(self.bc.horizon if horizon is None else horizon),
         )
 
     def init(self, key: jax.Array) -> TrainState:
         k_policy, k_run = jax.random.split(key)
         pstate = self.policy.init(k_policy)
-        env, cfg = self.env, self.cfg
+        env, bc = self.env, self.bc
         return TrainState(
             policy=pstate,
             opt_state=self.optimiser.init(pstate.params),
-            online=None if cfg.policy_ema == 0 else jax.tree_util.tree_map(jnp.copy, pstate.params),
-            buffer=relabel_buffer.init(cfg.buffer_size, env.obs_size, env.goal_size, env.action_size),
+            online=None if bc.policy_ema == 0 else jax.tree_util.tree_map(jnp.copy, pstate.params),
+            buffer=relabel_buffer.init(bc.buffer_size, env.obs_size, env.goal_size, env.action_size),
             key=k_run,
             iteration=jnp.int32(0),
         )
@@ -107,14 +107,14 @@ class Trainer:
         )(ts, hyper)
 
     def _iteration(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
-        env, cfg, policy = self.env, self.cfg, self.policy
+        env, cfg, bc, policy = self.env, self.cfg, self.bc, self.policy
         key, k_explore, k_bc, k_relabel = jax.random.split(ts.key, 4)
         reset_keys, noise = draws(env, k_explore, cfg.num_envs)
         horizon = self.horizon_at(ts.iteration, hyper)
         sigma = self.sigma_at(ts.iteration, hyper)
         seen, cands = self.explore_and_select(ts.policy, reset_keys, noise, sigma, horizon)
         if cfg.algo == "gcsl":
-            cands = gcsl.relabel(env, seen, cfg.gcsl_relabel, k_relabel)
+            cands = gcsl.relabel(env, seen, bc.gcsl_relabel, k_relabel)
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
         pstate = policy.update_normaliser(ts.policy, seen.obs, seen.achieved[:-1], ~seen.invalid[:-1])
         pstate, opt_state, online, loss = bc_epoch(
@@ -124,10 +124,10 @@ class Trainer:
             ts.opt_state,
             buf,
             k_bc,
-            cfg.bc_steps,
-            cfg.batch_size,
+            bc.bc_steps,
+            bc.batch_size,
             online=ts.online,
-            ema=cfg.policy_ema,
+            ema=bc.policy_ema,
         )
         metrics = {
             "select_pairs": jnp.sum(cands.valid, dtype=jnp.int32),
@@ -166,7 +166,7 @@ class Trainer:
         return seen, Candidates(*whole, jax.lax.psum(cands.replay_steps, ENVS))
 
     def _explore_and_select(self, pstate, reset_keys, noise, sigma, horizon) -> tuple[Seen, Candidates | None]:
-        env, cfg = self.env, self.cfg
+        env, cfg, bc = self.env, self.cfg, self.bc
         traj = rollout(env, self.policy, pstate, reset_keys, noise, sigma)
         if cfg.algo == "gcsl":
             return traj.seen(), None
@@ -177,18 +177,18 @@ class Trainer:
             traj,
             self.max_horizon,
             horizon,
-            cfg.select,
-            cfg.select_lanes,
-            hold=cfg.relabel in ("hold", "settle"),
-            settle=cfg.relabel == "settle",
-            radius=cfg.select_radius,
+            bc.select,
+            bc.select_lanes,
+            hold=bc.relabel in ("hold", "settle"),
+            settle=bc.relabel == "settle",
+            radius=bc.select_radius,
         )
         return traj.seen(), cands
 
     def sigma_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
         """This iteration's exploration noise: sigma, falling linearly to sigma_end x sigma over the
         first sigma_anneal iterations."""
-        fraction = optax.linear_schedule(1.0, self.cfg.sigma_end, max(1, self.cfg.sigma_anneal - 1))
+        fraction = optax.linear_schedule(1.0, self.bc.sigma_end, max(1, self.bc.sigma_anneal - 1))
         return hyper.sigma * fraction(iteration)
 
     def horizon_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:

@@ -12,6 +12,7 @@ import pytest
 
 import envs
 from splid_jax.config import TrainConfig
+from splid_jax.learners import registry
 from splid_jax.runtime import checkpoint, loop
 from splid_jax.train import main
 
@@ -40,7 +41,7 @@ def stable(run_dir):
 def final_state(run_dir):
     with open(os.path.join(run_dir, "config.json")) as fh:
         cfg = TrainConfig.from_json(json.load(fh))
-    algo = loop.make_algorithm(cfg, envs.make(cfg.env))
+    algo = registry.make_algorithm(cfg, envs.make(cfg.env))
     step, state, _ = checkpoint.restore(str(run_dir), jax.eval_shape(algo.init, jax.random.PRNGKey(0)))
     return step, jax.tree_util.tree_leaves(state)
 
@@ -95,11 +96,11 @@ def test_bad_algo_options_are_one_line_naming_the_field(tmp_path, capsys, args, 
 
 
 def test_options_reach_the_config_with_their_types():
-    her = TrainConfig(algo="her", her_options="hidden=16,16,batch_size=32,polyak=0.9").her_config()
+    her = TrainConfig(algo="her", her_options="hidden=16,16,batch_size=32,polyak=0.9").learner_config()
     assert (her.hidden, her.batch_size, her.polyak) == ((16, 16), 32, 0.9)
     es = TrainConfig(algo="es", es_options="population=8,episodes_per_member=2,antithetic=false")
-    assert es.es_config().antithetic is False and es.num_envs == 16  # episodes per generation
-    assert TrainConfig(algo="her").her_config().batch_size == 2048  # Baselines: 8 workers x 256
+    assert es.learner_config().antithetic is False and es.num_envs == 16  # episodes per generation
+    assert TrainConfig(algo="her").learner_config().batch_size == 2048  # Baselines: 8 workers x 256
 
 
 def test_her_takes_its_own_defaults_on_fetch_tasks_only():

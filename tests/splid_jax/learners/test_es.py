@@ -11,7 +11,8 @@ import envs
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.common.evaluation import evaluate
 from splid_jax.config import TrainConfig
-from splid_jax.learners.es import ES, EsConfig
+from splid_jax.learners.es.config import EsConfig
+from splid_jax.learners.es.learner import ES
 
 CFG = dict(env="point", hidden=(32, 32), iterations=80, eval_every=10, eval_episodes=256)
 ES_CFG = dict(population=128, sigma=0.05)

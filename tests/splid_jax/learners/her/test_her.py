@@ -108,7 +108,7 @@ class FetchRewardPoint(PointFourRooms):
 
 
 def test_target_is_clipped_to_the_returns_the_sparse_reward_allows():
-    cfg = TrainConfig(**CFG)
+    cfg = TrainConfig(**CFG, algo="her")
     assert HER(FetchRewardPoint(), cfg).target_range == pytest.approx((-50.0, 0.0))  # Baselines' range
     assert HER(PointFourRooms(), cfg).target_range == pytest.approx((0.0, 50.0))  # 1 on the goal, else 0
     r = jnp.array([-1.0, -1.0, 0.0, 0.0])

@@ -8,8 +8,6 @@ SPLID's and unused here; ``TrainConfig`` sets ``cfg.num_envs`` to the episodes p
 
 from __future__ import annotations
 
-import dataclasses
-
 import jax
 import jax.numpy as jnp
 import optax
@@ -23,11 +21,11 @@ from evosax.core.fitness_shaping import (
 from flax import struct
 
 from envs.base import GoalEnv, State, step_batch
-from splid_jax.common.errors import check
 from splid_jax.common.evaluation import evaluate
 from splid_jax.common.networks import PolicyState, make_policy
 from splid_jax.config import TrainConfig
 from splid_jax.learners.base import params_finite
+from splid_jax.learners.es.config import EsConfig
 
 # Fitness shaping by name (evosax's functions): ranks make the update invariant to the return's scale.
 SHAPING = {
@@ -35,49 +33,6 @@ SHAPING = {
     "standardize": standardize_fitness_shaping_fn,
     "raw": identity_fitness_shaping_fn,
 }
-
-
-def _f(default, help: str):
-    return dataclasses.field(default=default, metadata={"help": help})
-
-
-@dataclasses.dataclass(frozen=True)
-class EsConfig:
-    """ES's own settings (errors name them ``es.FIELD``); SPLID's ``sigma`` and ``learning_rate`` in
-    ``TrainConfig`` do not apply to ES, and its ``num_envs`` follows the population."""
-
-    population: int = _f(256, "ES population per generation (even when antithetic); each member plays its episodes")
-    sigma: float = _f(0.02, "std of the Gaussian parameter perturbations (Salimans et al.: 0.02)")
-    learning_rate: float = _f(0.01, "Adam learning rate on the ES gradient estimate")
-    antithetic: bool = _f(True, "antithetic sampling: members come in mirrored pairs theta +- sigma * eps")
-    paired_episodes: bool = _f(
-        True,
-        "antithetic pairs play the same starts and goals, so their returns differ by the perturbation only",
-    )
-    fitness_shaping: str = _f("centered_rank", "fitness shaping: " + ", ".join(SHAPING))
-    episodes_per_member: int = _f(1, "episodes per member per generation; its fitness is their mean return")
-    weight_decay: float = _f(
-        0.0, "L2 penalty on the member's parameters, subtracted from its return before shaping (0: none)"
-    )
-
-    def __post_init__(self):
-        check(self.population >= 2, "es.population", self.population, "an integer >= 2")
-        check(
-            not self.antithetic or self.population % 2 == 0,
-            "es.population",
-            self.population,
-            "an even integer with antithetic sampling",
-        )
-        check(self.sigma > 0, "es.sigma", self.sigma, "> 0")
-        check(self.learning_rate > 0, "es.learning_rate", self.learning_rate, "> 0")
-        check(
-            self.fitness_shaping in SHAPING,
-            "es.fitness_shaping",
-            self.fitness_shaping,
-            "one of " + ", ".join(SHAPING),
-        )
-        check(self.episodes_per_member >= 1, "es.episodes_per_member", self.episodes_per_member, "an integer >= 1")
-        check(self.weight_decay >= 0, "es.weight_decay", self.weight_decay, ">= 0")
 
 
 @struct.dataclass
@@ -94,7 +49,8 @@ class ES:
 
     name = "es"
 
-    def __init__(self, env: GoalEnv, cfg: TrainConfig, es: EsConfig):
+    def __init__(self, env: GoalEnv, cfg: TrainConfig, es: EsConfig | None = None):
+        es = cfg.learner_config() if es is None else es
         self.env, self.cfg, self.es = env, cfg, es
         self.policy = make_policy(env.obs_size, env.goal_size, env.action_size, cfg.hidden, normalise=False)
         template = self.policy.init(jax.random.PRNGKey(0)).params  # shapes only, for evosax's ravel
