@@ -20,7 +20,8 @@ from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 from splid_jax.learners.registry import make_algorithm
 from splid_jax.runtime import checkpoint
-from splid_jax.runtime.loop import env_settings, make_env
+from splid_jax.runtime.loop import make_env
+from splid_jax.runtime.run_files import env_settings
 
 DESCRIPTION = (
     "Roll a run's deterministic policy out, report its success and draw the episodes: their paths, "

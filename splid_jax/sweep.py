@@ -35,7 +35,13 @@ from splid_jax.cli import (  # noqa: E402
 from splid_jax.common.errors import InvalidConfig, check  # noqa: E402
 from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
 from splid_jax.learners import registry  # noqa: E402
-from splid_jax.runtime import checkpoint, loop, multihost, progress  # noqa: E402
+from splid_jax.runtime import (  # noqa: E402
+    checkpoint,
+    loop,
+    multihost,
+    progress,
+    run_files,  # noqa: E402
+)
 from splid_jax.runtime.loop import RunStopped, make_env  # noqa: E402
 
 
@@ -126,18 +132,18 @@ def build_parser() -> Parser:
 def resume_configs(run_dir: str, given: dict) -> tuple[TrainConfig, list[TrainConfig]]:
     """The sweep's and its members' configs from RUN_DIR/sweep.json; only ``MAY_CHANGE_ON_RESUME``
     fields (iterations, checkpoint_every) may be given anew."""
-    changed = [k for k in given if k not in loop.MAY_CHANGE_ON_RESUME]
+    changed = [k for k in given if k not in run_files.MAY_CHANGE_ON_RESUME]
     if changed:
         raise InvalidConfig(changed[0], given[changed[0]], "as in the sweep being resumed (only iterations may change)")
     try:
-        with open(os.path.join(run_dir, loop.SWEEP)) as fh:
+        with open(os.path.join(run_dir, run_files.SWEEP)) as fh:
             saved = json.load(fh)
         base = TrainConfig(**{**saved["config"], **given, "run_dir": run_dir})
         lanes = [
             TrainConfig(**{**m, **given, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in saved["members"]
         ]
     except (OSError, json.JSONDecodeError, KeyError, TypeError):
-        raise InvalidConfig("resume", run_dir, f"a sweep directory holding its {loop.SWEEP}") from None
+        raise InvalidConfig("resume", run_dir, f"a sweep directory holding its {run_files.SWEEP}") from None
     return base, lanes
 
 

@@ -32,7 +32,8 @@ from splid_jax.common.errors import InvalidConfig  # noqa: E402
 from splid_jax.config import PROVENANCE, TASK_DEFAULTS, TrainConfig  # noqa: E402
 from splid_jax.learners import registry  # noqa: E402
 from splid_jax.runtime import checkpoint, loop, multihost, progress  # noqa: E402
-from splid_jax.runtime.loop import MAY_CHANGE_ON_RESUME, RunStopped, env_settings, make_env  # noqa: E402
+from splid_jax.runtime.loop import RunStopped, make_env  # noqa: E402
+from splid_jax.runtime.run_files import MAY_CHANGE_ON_RESUME, env_settings  # noqa: E402
 
 __all__ = ["RunStopped", "build_parser", "config_from_cli", "env_settings", "main", "make_env", "run"]
 

@@ -2,7 +2,7 @@
 
 A sweep splits its members into equal groups, one per device (``MEMBERS``): each device runs the
 one-device program of its group, so a group computes exactly what a sweep of its members computes
-on one device (``loop._Groups``). A single run of a behaviour-cloning learner splits its envs
+on one device (``groups.Groups``). A single run of a behaviour-cloning learner splits its envs
 (``ENVS``): each device explores and SELECTs its slice, the relabelled pairs are gathered in the
 one-device layout, and the buffer, the BC step and the parameters are replicated
 (``trainer.Trainer``).

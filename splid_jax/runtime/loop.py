@@ -6,9 +6,9 @@ resumes bit for bit. The chunk is traced, checked against the device's memory an
 (``jax.jit(...).trace(...).lower().compile()``) before any state is allocated, so a run that cannot
 fit is refused with its estimate and the compile is timed apart from the first chunk.
 
-SIGINT (Ctrl-C) and SIGTERM (what a preemptible cluster sends) stop the run alike at any moment,
-compilation included: the newest state that is whole is checkpointed and ``Interrupted`` raised,
-which the command lines turn into exit code 130 (SIGINT) or 143 (SIGTERM)."""
+A signal stops the run at any moment with its newest whole state checkpointed (``signals``); the run
+directory's files are ``run_files``', the memory check ``memory``'s, a sweep split over devices
+``groups``'."""
 
 from __future__ import annotations
 
@@ -18,9 +18,8 @@ import io
 import json
 import os
 import signal
-import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import jax
@@ -33,43 +32,31 @@ from splid_jax.config import TrainConfig
 from splid_jax.learners import registry
 from splid_jax.learners.base import EVAL_KEYS, Algorithm
 from splid_jax.runtime import checkpoint, devices, multihost, progress
+from splid_jax.runtime.groups import Groups
+from splid_jax.runtime.memory import DoesNotFit, check_memory, compile_hint, gigabytes, largest_value, nbytes, sizes
+from splid_jax.runtime.run_files import (
+    METRICS,
+    SWEEP,
+    check_run_dir,
+    check_writable,
+    env_settings,
+    identity,
+    read_metrics,
+    write_atomic,
+    write_json,
+)
+from splid_jax.runtime.signals import Interrupted, Signals
 
-# Fields a resumed run must share with its checkpoint; the rest may change on resume.
-MAY_CHANGE_ON_RESUME = frozenset({"iterations", "run_dir", "checkpoint_every", "num_devices"})
 COUNTER_KEYS = ("iteration", "episodes", "env_steps", "select_steps")
-METRICS = "metrics.jsonl"
-SWEEP = "sweep.json"  # a sweep's config and its members' configs, from which it resumes
 
 
 class RunStopped(RuntimeError):
     """The run stopped early for a reason the user must see (NaN); exit code 3."""
 
 
-class Interrupted(KeyboardInterrupt):
-    """SIGINT or SIGTERM stopped the run; ``exit_code`` is 128 + the signal's number."""
-
-    def __init__(self, signum: int):
-        super().__init__(signal.Signals(signum).name)
-        self.signum = signum
-        self.exit_code = 128 + signum
-
-
-class DoesNotFit(InvalidConfig):
-    """The run's arrays cannot fit the device's memory."""
-
-    def __init__(self, message: str):
-        ValueError.__init__(self, message)
-        self.field, self.value, self.allowed = "num_envs", None, message
-
-
 def make_env(name: str, **overrides) -> envs.GoalEnv:
     with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
         return envs.make(name, **overrides)
-
-
-def env_settings(env: envs.GoalEnv) -> dict:
-    """The task's every option as JSON stores it: a resume under other task defaults fails naming one."""
-    return json.loads(json.dumps(env.settings()))
 
 
 def placement(cfg: TrainConfig, members: int | None, algo: Algorithm | None = None) -> devices.Placement:
@@ -85,217 +72,6 @@ def placement(cfg: TrainConfig, members: int | None, algo: Algorithm | None = No
             raise InvalidConfig("num_devices", cfg.num_devices, allowed)
         return devices.place(1, 1, devices.ENVS)
     return devices.place(cfg.num_devices, cfg.num_envs, devices.ENVS)
-
-
-def identity(cfg: TrainConfig) -> dict:
-    """The settings a checkpoint must share with the run resuming it, as JSON stores them."""
-    return json.loads(json.dumps({k: v for k, v in cfg.to_json().items() if k not in MAY_CHANGE_ON_RESUME}))
-
-
-# ---------------------------------------------------------------------------------------------
-# Signals
-
-
-class _Signals:
-    """SIGINT and SIGTERM only set a flag, read between steps. Blocking work (tracing, compiling, a
-    chunk) runs in a daemon thread while the main thread waits in short slices, so a signal is seen
-    within a fraction of a second instead of after a compilation of minutes.
-
-    Over several processes a signal is acted on only after a chunk, where every process learns of it
-    (``agree``): all then stop at the same iteration and take part in its checkpoint."""
-
-    def __init__(self):
-        self.signum: int | None = None
-        self.shared = jax.process_count() > 1
-        self._previous: dict[int, Any] = {}
-
-    def __enter__(self) -> _Signals:
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                self._previous[sig] = signal.signal(sig, self._caught)
-        return self
-
-    def __exit__(self, *exc) -> None:
-        for sig, handler in self._previous.items():
-            signal.signal(sig, handler)
-
-    def _caught(self, signum, frame) -> None:
-        if self.signum is None:
-            self.signum = signum
-
-    def check(self) -> None:
-        if self.signum is not None and not self.shared:
-            raise Interrupted(self.signum)
-
-    def agree(self) -> None:
-        """``check``, after every process has told the others of the signal it got, if any."""
-        if self.shared:
-            self.signum = multihost.any_of(self.signum or 0) or None
-            if self.signum is not None:
-                raise Interrupted(self.signum)
-        self.check()
-
-    def wait(self, fn: Callable[[], Any]) -> Any:
-        """``fn()`` in a daemon thread; raises ``Interrupted`` as soon as a signal came (the thread is
-        left to finish or to die with the process)."""
-        self.check()
-        box: dict[str, Any] = {}
-
-        def work():
-            try:
-                box["out"] = fn()
-            except BaseException as e:  # handed to the main thread as is
-                box["err"] = e
-
-        thread = threading.Thread(target=work, name="splid_jax-work", daemon=True)
-        thread.start()
-        while thread.is_alive():
-            thread.join(0.05)
-            self.check()
-        if "err" in box:
-            raise box["err"]
-        return box["out"]
-
-
-# ---------------------------------------------------------------------------------------------
-# Run directories
-
-
-def read_metrics(path: str) -> list[dict]:
-    return progress.read_metrics(path, checkpoint.CheckpointError)
-
-
-def _write_atomic(path: str, text: str) -> None:
-    tmp = path + ".tmp"
-    with open(tmp, "w") as fh:
-        fh.write(text)
-    os.replace(tmp, path)
-
-
-def write_json(path: str, obj) -> None:
-    """``obj`` as JSON at ``path``, replaced whole: a reader never sees half a file."""
-    _write_atomic(path, json.dumps(obj, indent=2, allow_nan=False))
-
-
-def _holds_metrics(run_dir: str) -> str | None:
-    """A sweep's record, or a metrics.jsonl with content in ``run_dir`` or one level below (a sweep's members)."""
-    if not os.path.isdir(run_dir):
-        return None
-    if os.path.isfile(os.path.join(run_dir, SWEEP)):
-        return os.path.join(run_dir, SWEEP)
-    candidates = [os.path.join(run_dir, METRICS)]
-    candidates += [os.path.join(run_dir, d, METRICS) for d in sorted(os.listdir(run_dir))]
-    for path in candidates:
-        if os.path.isfile(path) and os.path.getsize(path) > 0:
-            return path
-    return None
-
-
-def check_run_dir(cfg: TrainConfig, resume: bool) -> int | None:
-    """Refuses a run that would overwrite another, or a resume to fewer iterations than done;
-    returns the step a resume starts from."""
-    if not resume:
-        if os.path.isdir(cfg.run_dir) and checkpoint.latest_step(cfg.run_dir) is not None:
-            raise InvalidConfig("run_dir", cfg.run_dir, "a directory without a run in it (or pass --resume RUN_DIR)")
-        held = _holds_metrics(cfg.run_dir)
-        if held is not None:
-            raise InvalidConfig("run_dir", cfg.run_dir, f"a directory without a run in it (it holds {held})")
-        return None
-    step = checkpoint.latest_step(cfg.run_dir) if os.path.isdir(cfg.run_dir) else None
-    if step is None:
-        raise InvalidConfig("resume", cfg.run_dir, "a run directory holding a checkpoint")
-    if step > cfg.iterations:
-        raise InvalidConfig("iterations", cfg.iterations, f">= {step}, the iterations {cfg.run_dir} has completed")
-    return step
-
-
-def check_writable(run_dir: str) -> None:
-    """Creates ``run_dir`` and a file in it, then removes what it made: a read-only filesystem or
-    /proc fails here, naming the directory, before any work."""
-    made, path = [], os.path.abspath(run_dir)
-    while not os.path.exists(path):
-        made.append(path)
-        path = os.path.dirname(path)
-    try:
-        for d in reversed(made):
-            os.mkdir(d)
-        probe = os.path.join(run_dir, f".write-test-{os.getpid()}")
-        with open(probe, "w") as fh:
-            fh.write("x")
-        os.remove(probe)
-    except OSError as e:
-        raise InvalidConfig("run_dir", run_dir, f"a writable directory ({e.strerror})") from None
-    finally:
-        for d in made:
-            with contextlib.suppress(OSError):
-                os.rmdir(d)
-
-
-# ---------------------------------------------------------------------------------------------
-# Memory
-
-
-def _nbytes(aval) -> int:
-    shape = getattr(aval, "shape", None)
-    if shape is None:
-        return 0
-    try:
-        itemsize = np.dtype(aval.dtype).itemsize
-    except TypeError:  # extended dtypes (typed PRNG keys)
-        itemsize = 8
-    return int(np.prod(shape, dtype=np.int64)) * itemsize
-
-
-def _subjaxprs(value):
-    if hasattr(value, "eqns"):
-        yield value
-    elif hasattr(value, "jaxpr") and hasattr(value.jaxpr, "eqns"):
-        yield value.jaxpr
-    elif isinstance(value, tuple | list):
-        for v in value:
-            yield from _subjaxprs(v)
-
-
-def largest_value(jaxpr) -> int:
-    """Bytes of the largest set of values one operation of ``jaxpr`` (nested ones included) makes:
-    a lower bound of the memory the program needs beside its inputs and outputs."""
-    best = 0
-    for eqn in jaxpr.eqns:
-        best = max(best, sum(_nbytes(v.aval) for v in eqn.outvars))
-        for value in eqn.params.values():
-            for sub in _subjaxprs(value):
-                best = max(best, largest_value(sub))
-    return best
-
-
-def device_memory(device) -> tuple[int, str]:
-    """Bytes the device may hold, and where the figure comes from."""
-    stats = device.memory_stats() if hasattr(device, "memory_stats") else None
-    if stats and stats.get("bytes_limit"):
-        return int(stats["bytes_limit"]), f"{device.device_kind} memory"
-    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"), "host RAM"
-
-
-def _gb(n: float) -> str:
-    return f"{n / 1e9:.1f} GB" if n >= 1e8 else f"{n / 1e6:.1f} MB"
-
-
-def _sizes(cfg: TrainConfig, members: int) -> str:
-    sizes = f"num_envs={cfg.num_envs}, buffer_size={cfg.buffer_size}, eval_episodes={cfg.eval_episodes}"
-    return sizes + (f", {members} sweep members" if members > 1 else "")
-
-
-def check_memory(need: int, what: str, device, cfg: TrainConfig, members: int) -> None:
-    limit, source = device_memory(device)
-    if need > limit:
-        raise DoesNotFit(
-            f"invalid sizes ({_sizes(cfg, members)}): the run needs at least {_gb(need)} ({what}) "
-            f"but {source} is {_gb(limit)}"
-        )
-
-
-# ---------------------------------------------------------------------------------------------
-# The loop
 
 
 def _lane_hyper(algo: Algorithm, base: TrainConfig, lane: TrainConfig) -> Any:
@@ -331,13 +107,6 @@ def _abstract(tree, sharding):
     return jax.tree.map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=sharding), tree)
 
 
-def compile_hint(env: envs.GoalEnv) -> str:
-    """Roughly how long the first compilation takes, as measured for this kind of task."""
-    if type(env).__module__.startswith("envs.fetch"):
-        return "about 3 minutes for an MJX task on a 2-core CPU, under a minute on a GPU"
-    return "about 15 s on a 2-core CPU, a few seconds on a GPU"
-
-
 def _record(algo, cfg, metrics: dict, i: int | None, iteration: int, total: int, chunk: int, chunk_s, wall_s):
     rec = algo.counters(iteration, total)
     rec.update({k: metrics[k] if i is None else metrics[k][i] for k in EVAL_KEYS})
@@ -367,12 +136,12 @@ def run(
     place = placement(cfg, None if members is None else len(members), algo)
     split_envs = place.axis == devices.ENVS and place.count > 1
     algo = algo or registry.make_algorithm(cfg, env, place.mesh if split_envs else None)
-    with _Signals() as signals:
+    with Signals() as signals:
         return _Loop(cfg, env, algo, members, place, signals, quiet).run(resume)
 
 
 class _Loop:
-    def __init__(self, cfg, env, algo, members, place: devices.Placement, signals: _Signals, quiet: bool):
+    def __init__(self, cfg, env, algo, members, place: devices.Placement, signals: Signals, quiet: bool):
         self.cfg, self.env, self.algo, self.signals = cfg, env, algo, signals
         self.writes = multihost.is_first()  # the others compute their share and leave the run directory alone
         self.quiet = quiet or not self.writes
@@ -381,7 +150,7 @@ class _Loop:
         self.place = place
         self.device = place.first
         self.saved_at: int | None = None
-        self.groups: _Groups | None = None
+        self.groups: Groups | None = None
 
     def show(self, text: str) -> None:
         progress.show(text, self.quiet)
@@ -423,7 +192,7 @@ class _Loop:
         else:
             keys, hyper = keys[0], hypers[0]
         split = self.stacked and place.axis == devices.MEMBERS and place.count > 1
-        groups = _Groups(place, len(self.lanes)) if split else None
+        groups = Groups(place, len(self.lanes)) if split else None
         sharding = place.state_sharding() if groups is None else jax.sharding.SingleDeviceSharding(self.device)
         like = _abstract(jax.eval_shape(init, keys), sharding)  # the whole sweep's, as checkpoints hold it
         one = like if groups is None else groups.first(like)  # what one compiled program takes
@@ -432,13 +201,13 @@ class _Loop:
             traced = self.signals.wait(lambda: jax.jit(chunk).trace(one, groups.first(hyper) if groups else hyper))
         except OverflowError as e:  # an index past int32: sizes far beyond any device's memory
             raise DoesNotFit(
-                f"invalid sizes ({_sizes(cfg, len(self.lanes))}): too large for the program's 32-bit indices, "
+                f"invalid sizes ({sizes(cfg, len(self.lanes))}): too large for the program's 32-bit indices, "
                 "and for any device's memory"
             ) from e
-        state_bytes = sum(_nbytes(x) for x in jax.tree.leaves(one))
+        state_bytes = sum(nbytes(x) for x in jax.tree.leaves(one))
         largest = largest_value(traced.jaxpr.jaxpr)
-        check_memory(2 * state_bytes + largest, f"state {_gb(state_bytes)} twice, largest intermediate {_gb(largest)}",
-                     self.device, cfg, len(self.lanes))  # fmt: skip
+        what = f"state {gigabytes(state_bytes)} twice, largest intermediate {gigabytes(largest)}"
+        check_memory(2 * state_bytes + largest, what, self.device, cfg, len(self.lanes))
 
         processes = f" of {jax.process_count()} processes" if jax.process_count() > 1 else ""
         on = f"{place.count} devices{processes} split by {place.axis}" if place.count > 1 else self.device.platform
@@ -466,7 +235,7 @@ class _Loop:
             select_steps, wall_before = [0] * len(self.lanes), 0.0
             for lane in self.lanes if self.writes else ():
                 os.makedirs(lane.run_dir, exist_ok=True)
-                _write_atomic(os.path.join(lane.run_dir, METRICS), "")
+                write_atomic(os.path.join(lane.run_dir, METRICS), "")
         for lane in self.lanes if self.writes else ():
             write_json(os.path.join(lane.run_dir, "config.json"), {**lane.to_json(), "devices": place.record()})
         if self.stacked and self.writes:
@@ -483,13 +252,13 @@ class _Loop:
             for lane in self.lanes:  # lines written past the checkpoint are dropped, as is a torn last line
                 path = os.path.join(lane.run_dir, METRICS)
                 kept = [r for r in read_metrics(path) if r["iteration"] <= step]
-                _write_atomic(path, "".join(json.dumps(r) + "\n" for r in kept))
+                write_atomic(path, "".join(json.dumps(r) + "\n" for r in kept))
             return step, state, meta
 
         step, state, meta = self.signals.wait(lambda: multihost.from_first(read))
         self.show(f"resumed {cfg.run_dir} at iteration {step}")
         if self.stacked and self.place.axis == devices.MEMBERS and self.place.count > 1:
-            state = _Groups(self.place, len(self.lanes)).split(state)
+            state = Groups(self.place, len(self.lanes)).split(state)
         else:
             state = _canonical(state, self.place.state_sharding())
         return state, [int(s) for s in meta["select_steps"]], float(meta["wall_s"])
@@ -562,57 +331,3 @@ class _Loop:
             self.save(state, iteration, select_steps, wall())
             raise
         return last
-
-
-class _Groups:
-    """A sweep's members in equal groups, one per device, each group a single-device program (the
-    vmapped chunk as one device runs it). Dispatch is asynchronous, so the devices run at once; a
-    group computes exactly what a sweep of its members computes on one device, and no collective
-    or SPMD partitioning is involved (XLA:GPU failed to compile MJX chunks partitioned by
-    ``shard_map``, and XLA:CPU under jaxlib 0.10 can hang in multi-device programs). Over several
-    processes each runs the groups of its own devices, and the members' metrics and checkpointed
-    state are gathered between chunks (``multihost.concat``)."""
-
-    def __init__(self, place: devices.Placement, members: int):
-        every = list(place.mesh.devices.flat)
-        self.size = members // len(every)
-        self.devices = {i: d for i, d in enumerate(every) if d.process_index == jax.process_index()}  # group: device
-
-    def first(self, tree):
-        return jax.tree.map(lambda x: _slice(x, 0, self.size), tree)
-
-    def on(self, tree, device):
-        sharding = jax.sharding.SingleDeviceSharding(device)
-        return jax.tree.map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=sharding), tree)
-
-    def split(self, tree) -> tuple:
-        """This process's groups of the whole sweep's ``tree``."""
-        host = jax.device_get(tree)
-        return tuple(
-            jax.device_put(jax.tree.map(lambda x, i=i: _slice(x, i * self.size, self.size), host), device)
-            for i, device in self.devices.items()
-        )
-
-    def join(self, groups: tuple):
-        """The whole sweep's state to checkpoint, on the host of every process, from this process's groups."""
-        return checkpoint.on_host(multihost.concat(_concat(jax.device_get(groups))))
-
-    def compile(self, first, compile_on, signals: _Signals):
-        rest = [signals.wait(lambda d=d: compile_on(d)) for d in list(self.devices.values())[1:]]
-        programs = [first, *rest]
-
-        def run(states: tuple, hypers: tuple):
-            outs = [p(s, h) for p, s, h in zip(programs, states, hypers, strict=True)]  # dispatched at once
-            return tuple(o[0] for o in outs), multihost.concat(_concat([o[1] for o in outs]))
-
-        return run
-
-
-def _concat(groups):
-    return jax.tree.map(lambda *xs: np.concatenate([np.asarray(x) for x in xs]), *groups)
-
-
-def _slice(x, start: int, size: int):
-    if isinstance(x, jax.ShapeDtypeStruct):
-        return jax.ShapeDtypeStruct((size,) + x.shape[1:], x.dtype, sharding=x.sharding)
-    return x[start : start + size]

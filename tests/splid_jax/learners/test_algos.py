@@ -13,7 +13,7 @@ import pytest
 import envs
 from splid_jax.config import TrainConfig
 from splid_jax.learners import registry
-from splid_jax.runtime import checkpoint, loop
+from splid_jax.runtime import checkpoint, run_files
 from splid_jax.train import main
 
 COMMON = ["--env", "point", "--eval-every", "2", "--eval-episodes", "16", "--quiet"]
@@ -35,7 +35,8 @@ def train(algo, run_dir, *extra):
 
 
 def stable(run_dir):
-    return [{k: v for k, v in r.items() if k not in VOLATILE} for r in loop.read_metrics(f"{run_dir}/metrics.jsonl")]
+    records = run_files.read_metrics(f"{run_dir}/metrics.jsonl")
+    return [{k: v for k, v in r.items() if k not in VOLATILE} for r in records]
 
 
 def final_state(run_dir):
@@ -57,7 +58,7 @@ def test_each_algo_writes_the_schema_and_resumes_bit_for_bit(tmp_path, algo):
 
     records = stable(straight)
     assert [r["iteration"] for r in records] == [2, 4]
-    assert all(set(SCHEMA) <= set(r) for r in loop.read_metrics(f"{straight}/metrics.jsonl"))
+    assert all(set(SCHEMA) <= set(r) for r in run_files.read_metrics(f"{straight}/metrics.jsonl"))
     assert all(0 <= r["eval_success"] <= 1 and 0 <= r["eval_success_final"] <= r["eval_success"] for r in records)
     per_iteration = 4 if algo == "her" else 8  # ES: its population of 8, each member's episode
     assert records[-1]["episodes"] == 4 * per_iteration

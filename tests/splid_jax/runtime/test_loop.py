@@ -18,7 +18,8 @@ import envs
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 from splid_jax.learners.base import EVAL_KEYS
-from splid_jax.runtime import checkpoint, loop
+from splid_jax.runtime import checkpoint, loop, run_files
+from splid_jax.runtime.signals import Signals
 
 ENV = envs.make("point")
 
@@ -82,7 +83,7 @@ def sweep_lanes(cfg, sigmas=(0.5, 1.0), seeds=(0, 1)):
 
 
 def records(run_dir):
-    return loop.read_metrics(os.path.join(run_dir, loop.METRICS))
+    return run_files.read_metrics(os.path.join(run_dir, run_files.METRICS))
 
 
 def without_time(recs):
@@ -143,7 +144,7 @@ def test_resume_continues_bit_for_bit_and_compiles_the_chunk_once(tmp_path, capl
 def test_a_torn_last_line_is_dropped_on_resume(tmp_path):
     cfg = config(tmp_path, iterations=4)
     run(cfg)
-    path = os.path.join(cfg.run_dir, loop.METRICS)
+    path = os.path.join(cfg.run_dir, run_files.METRICS)
     with open(path, "a") as fh:
         fh.write('{"iteration": 6, "episo')  # killed mid-write
     run(dataclasses.replace(cfg, iterations=6), resume=True)
@@ -154,7 +155,7 @@ def test_a_torn_last_line_is_dropped_on_resume(tmp_path):
 def test_a_finished_run_is_already_complete_and_left_untouched(tmp_path, capsys):
     cfg = config(tmp_path)
     run(cfg)
-    before = {p: (tmp_path / "run" / p).read_bytes() for p in ("config.json", loop.METRICS)}
+    before = {p: (tmp_path / "run" / p).read_bytes() for p in ("config.json", run_files.METRICS)}
     last = loop.run(cfg, ENV, algo=Toy(ENV, cfg), resume=True)
     assert "already complete" in capsys.readouterr().out
     assert last[0]["iteration"] == 6
@@ -171,10 +172,10 @@ def test_a_run_never_overwrites_another(tmp_path):
         run(cfg)
     lonely = tmp_path / "metrics-only"
     lonely.mkdir()
-    (lonely / loop.METRICS).write_text('{"iteration": 2}\n' * 30)
+    (lonely / run_files.METRICS).write_text('{"iteration": 2}\n' * 30)
     with pytest.raises(InvalidConfig, match="run_dir.*metrics.jsonl"):
         run(config(tmp_path, "metrics-only"))
-    assert (lonely / loop.METRICS).read_text() == '{"iteration": 2}\n' * 30
+    assert (lonely / run_files.METRICS).read_text() == '{"iteration": 2}\n' * 30
     sweep = config(tmp_path, "sweep", iterations=2)
     run(sweep, sweep_lanes(sweep))
     kept = records(sweep_lanes(sweep)[0].run_dir)
@@ -216,7 +217,7 @@ def test_nan_stops_the_run_and_keeps_the_last_good_state(tmp_path):
 def test_a_signal_during_a_chunk_saves_the_newest_whole_state(tmp_path):
     cfg = config(tmp_path, iterations=400, checkpoint_every=0)
     toy = Toy(ENV, cfg, sleep=0.2)
-    path = os.path.join(cfg.run_dir, loop.METRICS)
+    path = os.path.join(cfg.run_dir, run_files.METRICS)
 
     def send():
         while not (os.path.exists(path) and records(cfg.run_dir)[-1:] and records(cfg.run_dir)[-1]["iteration"] >= 4):
@@ -233,7 +234,7 @@ def test_a_signal_during_a_chunk_saves_the_newest_whole_state(tmp_path):
 
 def test_signals_stop_a_wait_at_once():
     before = signal.getsignal(signal.SIGINT)  # ignored where pytest runs as a background job
-    with loop._Signals() as signals:
+    with Signals() as signals:
         threading.Timer(0.2, os.kill, (os.getpid(), signal.SIGINT)).start()
         finished = threading.Event()
         with pytest.raises(loop.Interrupted) as info:
