@@ -12,6 +12,7 @@ import jax
 import jax.numpy as jnp
 
 from envs.base import GoalEnv
+from splid_jax.common.evaluation import evaluate
 
 # Keys every chunk's metrics carry (one scalar per member of a sweep), whatever the algorithm.
 EVAL_KEYS = ("eval_success", "eval_success_final", "eval_return")
@@ -42,4 +43,55 @@ class Algorithm(Protocol):
 
 
 def params_finite(params) -> jax.Array:
+    """Whether every parameter is finite (no NaN, no inf)."""
     return jnp.all(jnp.stack([jnp.all(jnp.isfinite(x)) for x in jax.tree_util.tree_leaves(params)]))
+
+
+class Chunked:
+    """The skeleton every learner shares: ``chunk`` scans ``cfg.eval_every`` iterations, evaluates the
+    deterministic policy once and checks for NaN the same way for all; ``counters`` counts exploration
+    the same way for all. A learner supplies one ``iteration`` and what its chunk reports.
+
+    Expects ``env``, ``cfg``, ``policy`` (``networks.Policy``) and a state with ``policy``, ``key``."""
+
+    env: GoalEnv
+    cfg: Any
+    policy: Any
+
+    def iteration(self, state: Any, hyper: Any) -> tuple[Any, dict]:
+        """One iteration: the new state and its metrics (scalars)."""
+        raise NotImplementedError
+
+    def chunk_metrics(self, state: Any, hyper: Any, per_iteration: dict) -> dict:
+        """The learner's own metrics of a chunk, from the state after it and every iteration's metrics."""
+        raise NotImplementedError
+
+    def watched(self, state: Any, per_iteration: dict) -> tuple[Any, jax.Array]:
+        """The parameters that must stay finite, and a bool array that is true where the chunk's losses were."""
+        raise NotImplementedError
+
+    @property
+    def episodes_per_iteration(self) -> int:
+        return self.cfg.num_envs
+
+    def chunk(self, state: Any, hyper: Any) -> tuple[Any, dict]:
+        state, per_iteration = jax.lax.scan(
+            lambda s, _: self.iteration(s, hyper), state, None, length=self.cfg.eval_every
+        )
+        key, k_eval = jax.random.split(state.key)
+        metrics = evaluate(self.env, self.policy, state.policy, k_eval, self.cfg.eval_episodes)
+        metrics.update(self.chunk_metrics(state, hyper, per_iteration))
+        params, losses_finite = self.watched(state, per_iteration)
+        metrics["finite"] = params_finite(params) & jnp.all(losses_finite)
+        return state.replace(key=key), metrics
+
+    def counters(self, iteration: int, select_steps: int) -> dict:
+        """Work done after ``iteration`` iterations, as exact Python ints: exploration episodes and env
+        steps, and the replay steps counted on the device (``select_steps``, summed by the caller)."""
+        episodes = iteration * self.episodes_per_iteration
+        return {
+            "iteration": iteration,
+            "episodes": episodes,
+            "env_steps": episodes * self.env.episode_length,
+            "select_steps": select_steps,
+        }

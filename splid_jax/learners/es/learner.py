@@ -21,10 +21,9 @@ from evosax.core.fitness_shaping import (
 from flax import struct
 
 from envs.base import GoalEnv, State, step_batch
-from splid_jax.common.evaluation import evaluate
 from splid_jax.common.networks import PolicyState, make_policy
 from splid_jax.config import TrainConfig
-from splid_jax.learners.base import params_finite
+from splid_jax.learners.base import Chunked
 from splid_jax.learners.es.config import EsConfig
 
 # Fitness shaping by name (evosax's functions): ranks make the update invariant to the return's scale.
@@ -43,7 +42,7 @@ class EsState:
     iteration: jax.Array  # [] int32, completed generations
 
 
-class ES:
+class ES(Chunked):
     """OpenAI-ES on the deterministic policy (``Policy.act``) without an input normaliser: a moving one
     would change every member's function between generations."""
 
@@ -129,25 +128,21 @@ class ES:
         }
         return EsState(search=search, policy=pstate, key=key, iteration=ts.iteration + 1), metrics
 
-    def chunk(self, ts: EsState, hyper: dict) -> tuple[EsState, dict]:
-        ts, per_gen = jax.lax.scan(lambda s, _: self.generation(s), ts, None, length=self.cfg.eval_every)
-        key, k_eval = jax.random.split(ts.key)
-        metrics = evaluate(self.env, self.policy, ts.policy, k_eval, self.cfg.eval_episodes)
-        metrics.update(
+    def iteration(self, ts: EsState, hyper: dict) -> tuple[EsState, dict]:
+        return self.generation(ts)
+
+    def chunk_metrics(self, ts: EsState, hyper: dict, per_gen: dict) -> dict:
+        return dict(
             fitness_mean=jnp.mean(per_gen["fitness_mean"]),  # mean member return over the chunk
             fitness_max=jnp.max(per_gen["fitness_max"]),  # best member return in the chunk
             explore_success=jnp.mean(per_gen["explore_success"]),
             explore_invalid=jnp.mean(per_gen["explore_invalid"]),
-            finite=params_finite(ts.search.mean) & jnp.all(jnp.isfinite(per_gen["fitness_mean"])),
         )
-        return ts.replace(key=key), metrics
 
-    def counters(self, iteration: int, select_steps: int) -> dict:
+    def watched(self, ts: EsState, per_gen: dict) -> tuple:
+        return ts.search.mean, jnp.isfinite(per_gen["fitness_mean"])
+
+    @property
+    def episodes_per_iteration(self) -> int:
         """Every member's episodes are exploration: P x E episodes of T steps per generation."""
-        episodes = iteration * self.es.population * self.es.episodes_per_member
-        return {
-            "iteration": iteration,
-            "episodes": episodes,
-            "env_steps": episodes * self.env.episode_length,
-            "select_steps": select_steps,
-        }
+        return self.es.population * self.es.episodes_per_member

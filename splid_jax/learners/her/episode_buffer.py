@@ -9,6 +9,8 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
+from splid_jax.common import ring_buffer
+
 
 @struct.dataclass
 class EpisodeBuffer:
@@ -40,24 +42,8 @@ def buffer_init(episodes: int, T: int, obs_size: int, goal_size: int, action_siz
 def buffer_insert(buf: EpisodeBuffer, new: EpisodeBuffer, mask: jax.Array) -> EpisodeBuffer:
     """Append the episodes of ``new`` where ``mask`` holds, in order, overwriting the oldest past
     capacity (of a batch larger than the capacity only the newest ``capacity`` are kept)."""
-    cap = buf.capacity
-    mask = mask.astype(bool)
-    n = jnp.sum(mask, dtype=jnp.int32)
-    rank = jnp.cumsum(mask, dtype=jnp.int32) - 1
-    skip = jnp.maximum(n - cap, 0)
-    slot = jnp.where(mask & (rank >= skip), (buf.ptr + rank - skip) % cap, cap)  # slot == cap is dropped
-
-    def put(old, rows):
-        return old.at[slot].set(rows, mode="drop")
-
-    return buf.replace(
-        obs=put(buf.obs, new.obs),
-        achieved=put(buf.achieved, new.achieved),
-        goal=put(buf.goal, new.goal),
-        actions=put(buf.actions, new.actions),
-        ptr=(buf.ptr + jnp.minimum(n, cap)) % cap,
-        size=jnp.minimum(buf.size + n, cap),
-    )
+    rows = {"obs": new.obs, "achieved": new.achieved, "goal": new.goal, "actions": new.actions}
+    return ring_buffer.insert(buf, rows, mask)
 
 
 class Transitions(NamedTuple):

@@ -15,10 +15,9 @@ from flax import struct
 
 from envs.base import GoalEnv, step_batch
 from splid_jax.common.errors import check
-from splid_jax.common.evaluation import evaluate
 from splid_jax.common.networks import CLIP_NORMALISED, MLP, Policy, PolicyState, running_statistics
 from splid_jax.config import TrainConfig
-from splid_jax.learners.base import params_finite
+from splid_jax.learners.base import Chunked
 from splid_jax.learners.her.config import HerConfig
 from splid_jax.learners.her.episode_buffer import (
     EpisodeBuffer,
@@ -48,7 +47,7 @@ class HerState:
     iteration: jax.Array  # [] int32, completed iterations (cycles)
 
 
-class HER:
+class HER(Chunked):
     """DDPG + HER; static parts only, all state flows through arguments."""
 
     name = "her"
@@ -214,26 +213,14 @@ class HER:
         metrics["explore_success"] = jnp.mean(success)
         return hs, metrics
 
-    def chunk(self, hs: HerState, hyper) -> tuple[HerState, dict]:
-        hs, per_iter = jax.lax.scan(lambda s, _: self.iteration(s, hyper), hs, None, length=self.cfg.eval_every)
-        key, k_eval = jax.random.split(hs.key)
-        metrics = evaluate(self.env, self.policy, hs.policy, k_eval, self.cfg.eval_episodes)
-        metrics.update(
+    def chunk_metrics(self, hs: HerState, hyper, per_iter: dict) -> dict:
+        return dict(
             critic_loss=per_iter["critic_loss"][-1],
             actor_loss=per_iter["actor_loss"][-1],
             q_mean=per_iter["q_mean"][-1],
             explore_success=jnp.mean(per_iter["explore_success"]),
             buffer_size=hs.buffer.size,
-            finite=params_finite((hs.policy.params, hs.critic)) & jnp.all(per_iter["losses_finite"]),
         )
-        return hs.replace(key=key), metrics
 
-    def counters(self, iteration: int, select_steps: int) -> dict:
-        """Exploration work after ``iteration`` iterations, as exact Python ints (HER replays nothing)."""
-        episodes = iteration * self.cfg.num_envs
-        return {
-            "iteration": iteration,
-            "episodes": episodes,
-            "env_steps": episodes * self.env.episode_length,
-            "select_steps": select_steps,
-        }
+    def watched(self, hs: HerState, per_iter: dict) -> tuple:
+        return (hs.policy.params, hs.critic), per_iter["losses_finite"]

@@ -10,6 +10,8 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
+from splid_jax.common import ring_buffer
+
 
 @struct.dataclass
 class Buffer:
@@ -42,21 +44,7 @@ def insert(buf: Buffer, obs: jax.Array, goal: jax.Array, action: jax.Array, mask
     chex.assert_equal_shape_suffix([obs, buf.obs], 1)
     chex.assert_equal_shape_suffix([goal, buf.goal], 1)
     chex.assert_equal_shape_suffix([action, buf.action], 1)
-    cap = buf.capacity
-    mask = mask.astype(bool)
-    n = jnp.sum(mask, dtype=jnp.int32)
-    rank = jnp.cumsum(mask, dtype=jnp.int32) - 1
-    skip = jnp.maximum(n - cap, 0)
-    keep = mask & (rank >= skip)
-    slot = jnp.where(keep, (buf.ptr + rank - skip) % cap, cap)  # slot == cap is dropped
-    written = jnp.minimum(n, cap)
-    return buf.replace(
-        obs=buf.obs.at[slot].set(obs, mode="drop"),
-        goal=buf.goal.at[slot].set(goal, mode="drop"),
-        action=buf.action.at[slot].set(action, mode="drop"),
-        ptr=(buf.ptr + written) % cap,
-        size=jnp.minimum(buf.size + n, cap),
-    )
+    return ring_buffer.insert(buf, {"obs": obs, "goal": goal, "action": action}, mask)
 
 
 def sample(buf: Buffer, key: jax.Array, batch_size: int) -> tuple[jax.Array, jax.Array, jax.Array]:

@@ -12,11 +12,10 @@ from jax.sharding import PartitionSpec as P
 
 from envs.base import GoalEnv
 from splid_jax.common.errors import check
-from splid_jax.common.evaluation import evaluate
 from splid_jax.common.networks import PolicyState, make_policy
 from splid_jax.config import TrainConfig
 from splid_jax.learners import gcsl
-from splid_jax.learners.base import params_finite
+from splid_jax.learners.base import Chunked
 from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.bc import bc_epoch
 from splid_jax.learners.imitation.candidates import Candidates
@@ -44,7 +43,7 @@ class Hyper:
     horizon: jax.Array  # [] int32, <= the trainer's max_horizon
 
 
-class Trainer:
+class Trainer(Chunked):
     """The behaviour-cloning learners as ``learners.base.Algorithm``s: SPLID (``cfg.algo`` "splid"), PCHID
     (SPLID whose horizon grows from 1 to H) and GCSL (every relabelled pair cloned). Holds what is
     static (task, network, optimiser, shapes); all state flows through arguments.
@@ -197,11 +196,8 @@ class Trainer:
             return hyper.horizon
         return jnp.minimum(hyper.horizon, 1 + iteration // self.pchid_every).astype(jnp.int32)
 
-    def chunk(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
-        ts, per_iter = jax.lax.scan(lambda s, _: self.iteration(s, hyper), ts, None, length=self.cfg.eval_every)
-        key, k_eval = jax.random.split(ts.key)
-        metrics = evaluate(self.env, self.policy, ts.policy, k_eval, self.cfg.eval_episodes)
-        metrics.update(
+    def chunk_metrics(self, ts: TrainState, hyper: Hyper, per_iter: dict) -> dict:
+        return dict(
             select_pairs=jnp.sum(per_iter["select_pairs"]),
             select_accepted=jnp.sum(per_iter["select_accepted"]),
             select_held=jnp.sum(per_iter["select_held"]),
@@ -212,18 +208,7 @@ class Trainer:
             bc_loss=per_iter["bc_loss"][-1],
             explore_success=jnp.mean(per_iter["explore_success"]),
             buffer_size=ts.buffer.size,
-            finite=params_finite((ts.policy.params, ts.online)) & jnp.all(jnp.isfinite(per_iter["bc_loss"])),
         )
-        return ts.replace(key=key), metrics
 
-    def counters(self, iteration: int, select_steps: int) -> dict:
-        """Work done after ``iteration`` iterations, as exact Python ints: exploration episodes and env
-        steps, and the SELECT replay steps counted on the device (``select_steps``, summed by the caller)."""
-        cfg = self.cfg
-        return {
-            "iteration": iteration,
-            "episodes": iteration * cfg.num_envs,
-            "env_steps": iteration * cfg.num_envs * self.env.episode_length,
-            "select_steps": select_steps,
-        }
-
+    def watched(self, ts: TrainState, per_iter: dict) -> tuple:
+        return (ts.policy.params, ts.online), jnp.isfinite(per_iter["bc_loss"])
