@@ -95,10 +95,9 @@ def flag_invalid(state: State) -> State:
     return state.replace(invalid=state.invalid | bad)
 
 
-# XLA:CPU (jaxlib 0.10.2, 2-core machine, 2026-11-23) parks every thread and never returns when a
-# vmapped MJX step of about 1,000 envs or more runs inside a loop: 750 envs ran, 1,000 did not, with
-# or without multi-threaded Eigen or async dispatch. On the CPU the batch is therefore stepped in
-# slices of this many envs; each env's step is independent, so only the schedule changes.
+# XLA:CPU can hang when a vmapped MJX step of about 1,000 envs or more runs inside a loop
+# (experiments/NOTES.md, "CPU step slices"). On the CPU the batch is therefore stepped in slices of
+# this many envs; each env's step is independent, so only the schedule changes.
 CPU_STEP_SLICE = 512
 
 

@@ -70,7 +70,7 @@ def task_fields() -> str:
     for name in envs.names():
         with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
             cls = envs.task_class(name)
-        defaults = {f.name: f.default for f in dataclasses.fields(cls)}
+        defaults = {f.name: _marked(f) for f in dataclasses.fields(cls)}
         if previous is not None and previous[1].keys() == defaults.keys():
             diff = {k: v for k, v in defaults.items() if v != previous[1][k]}
             shown = ", ".join(f"{k}={v}" for k, v in diff.items())
@@ -79,6 +79,11 @@ def task_fields() -> str:
             parts.append(f"{name}: " + ", ".join(f"{k}={v}" for k, v in defaults.items()))
             previous = (name, defaults)
     return "; ".join(parts)
+
+
+def _marked(f: dataclasses.Field) -> str:
+    """A task field's default, marked when the field is an experimental option."""
+    return f"{f.default} (experimental)" if f.metadata.get("experimental") else f"{f.default}"
 
 
 def _int_tuple(text: str) -> tuple[int, ...]:

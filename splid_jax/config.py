@@ -48,7 +48,8 @@ class TrainConfig:
         None,
         "splid/pchid candidates: paper (Algorithm 2 exactly), hold (also steps whose goal is already "
         "achieved and held for H steps, kept when the policy is not at the goal after H steps) or settle "
-        "(hold, and a moved goal only where the object then stays there H steps; every verdict at the final step)",
+        "(experimental: hold, and a moved goal only where the object then stays there H steps; every "
+        "verdict at the final step)",
     )
     select_radius: float = field(
         1.0,
@@ -212,14 +213,9 @@ _FETCH = dict(
     eval_every=5,
     eval_episodes=500,
 )
-# Push (BENCHMARKS.md, "Push" and "Final-step success"): raw inputs as the authors' code feeds them, a
-# 50k-pair FIFO buffer (the reference's is 100k) and a Polyak-averaged acting policy (decay 0.98) gave
-# the best any-step success of the settings measured; --relabel hold, the goal fed relative to the
-# cube, the noise annealed to half and a learning rate of 5e-4 take final-step success from 0.24 to
-# 0.91 at no any-step cost (5 seeds, 10,000 episodes). On Reach the relative goal alone takes
-# final-step success from 0.92 to 0.98 at 1,280 episodes (4 seeds; annealing the noise there cost
-# 1 point). Slide and PickAndPlace keep Algorithm 2 and run to 51,200 episodes: Push's settings
-# measured there gave the same success on both measures (5 seeds).
+# Push's and Reach's settings are those that learned best where they were compared; Slide and
+# PickAndPlace keep Algorithm 2, which Push's settings did not beat there (experiments/NOTES.md,
+# "Task defaults"; BENCHMARKS.md, "Push" and "Final-step success").
 TASK_DEFAULTS: dict[str, dict[str, Any]] = {
     "point": _POINT,
     "reach": {**_FETCH, "iterations": 20, "num_envs": 64, "relative_goal": True},

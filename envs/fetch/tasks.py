@@ -77,6 +77,11 @@ def quat_rotate(q: jax.Array, v: jax.Array) -> jax.Array:
     return v + 2.0 * jnp.cross(u, jnp.cross(u, v) + w * v)
 
 
+def experimental(default: str):
+    """A task field of the parity study: an option ``--help`` marks as experimental."""
+    return dataclasses.field(default=default, metadata={"experimental": True})
+
+
 @dataclasses.dataclass(frozen=True)
 class _FetchTask(GoalEnv):
     """Shared machinery; subclasses set the scene and the goal distribution."""
@@ -89,11 +94,17 @@ class _FetchTask(GoalEnv):
     substeps: int = 10
     iterations: int = 4
     ls_iterations: int = 4
-    table: str = "plane"  # the table's collision shape: its top face as a plane, or the reference's box
-    finger: str = "box"  # the closed finger block's collision shape (Push: box or capsule, see models.py)
-    cholesky: str = "unrolled"  # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
-    workspace: str = "arm"  # where the gripper target may go: the box and the reference arm's reach, or the box
-    drive: str = "pd"  # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
+    # Parity-study options (experimental): the reference's variants of parts of the physics.
+    # the table's collision shape: its top face as a plane, or the reference's box
+    table: str = experimental("plane")
+    # the closed finger block's collision shape (Push: box or capsule, see models.py)
+    finger: str = experimental("box")
+    # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
+    cholesky: str = experimental("unrolled")
+    # where the gripper target may go: the box and the reference arm's reach, or the box
+    workspace: str = experimental("arm")
+    # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
+    drive: str = experimental("pd")
 
     kind = ""  # models.KINDS entry
     has_object = True

@@ -72,8 +72,8 @@ def place(wanted: int, size: int, axis: str) -> Placement:
         raise InvalidConfig("num_devices", wanted, allowed)
     count = wanted or max(d for d in range(1, len(available) + 1) if size % (d * processes) == 0)
     if count > 1 and available[0].platform != "cpu":
-        # measured on two H200s (jax 0.11.2): XLA:GPU crashes compiling the envs split by shard_map
-        # and did not finish compiling the members' per-device programs within two minutes
+        # XLA:GPU fails to compile the envs split by shard_map, and the members' per-device programs
+        # (experiments/NOTES.md, "Split work on GPUs")
         raise InvalidConfig(
             "num_devices", wanted, f"1 on {available[0].platform} devices for now (split work runs on CPU devices)"
         )

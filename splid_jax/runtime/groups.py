@@ -14,7 +14,7 @@ class Groups:
     vmapped chunk as one device runs it). Dispatch is asynchronous, so the devices run at once; a
     group computes exactly what a sweep of its members computes on one device, and no collective
     or SPMD partitioning is involved (XLA:GPU failed to compile MJX chunks partitioned by
-    ``shard_map``, and XLA:CPU under jaxlib 0.10 can hang in multi-device programs). Over several
+    ``shard_map``, and XLA:CPU can hang in multi-device programs). Over several
     processes each runs the groups of its own devices, and the members' metrics and checkpointed
     state are gathered between chunks (``multihost.concat``)."""
 

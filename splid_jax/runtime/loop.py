@@ -94,8 +94,8 @@ def _get(tree, name):
 def _canonical(tree, sharding):
     """Strongly typed arrays placed as ``sharding`` says, whether they come from init or a checkpoint,
     so the compiled chunk takes a resumed state as it takes a fresh one."""
-    # made on one device, then placed: XLA:CPU under jaxlib 0.10 can hang in a later program that reads
-    # an array a multi-device jit wrote through out_shardings
+    # made on one device, then placed: XLA:CPU can hang in a later program that reads an array a
+    # multi-device jit wrote through out_shardings
     return jax.device_put(jax.jit(_strong)(tree), sharding)
 
 
