@@ -218,7 +218,9 @@ def test_corrupt_and_mismatched_checkpoints_fail_clearly(tmp_path, capsys):
                 with open(path, "r+b") as fh:
                     fh.truncate(os.path.getsize(path) // 2)
     assert main(["--resume", str(run_dir), "--iterations", "10", "--quiet"]) == 3
-    assert "error" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1
+    assert f"error: checkpoint {run_dir / 'checkpoints' / '5'} is corrupt or unreadable (" in err
 
 
 def test_env_options_build_the_task_the_run_trains_on(tmp_path):

@@ -48,6 +48,22 @@ def test_future_goals_come_uniformly_from_later_steps_of_the_same_episode(traj):
     assert all(s == T for t, s in later if t == T - 1)
 
 
+def test_pchid_horizon_grows_by_one_every_pchid_every_iterations_up_to_h():
+    env = envs.make("point")
+    small = dict(env="point", iterations=40, horizon=4, hidden=(8,))
+    pchid = Trainer(env, TrainConfig(**small, algo="pchid", pchid_every=3))
+    assert [int(pchid.horizon_at(jnp.int32(i), pchid.hyper())) for i in range(14)] == [
+        1, 1, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4, 4, 4
+    ]  # fmt: skip
+    resolved = Trainer(env, TrainConfig(**small, algo="pchid"))  # 0: H reached half-way, 40 // (2 * 4) = 5
+    assert [int(resolved.horizon_at(jnp.int32(i), resolved.hyper())) for i in (0, 4, 5, 19, 20, 39)] == [
+        1, 1, 2, 4, 4, 4
+    ]  # fmt: skip
+    for algo in ("splid", "gcsl"):  # the full horizon from the start
+        fixed = Trainer(env, TrainConfig(**small, algo=algo))
+        assert [int(fixed.horizon_at(jnp.int32(i), fixed.hyper())) for i in (0, 7, 39)] == [4, 4, 4]
+
+
 def test_gcsl_and_pchid_learn_on_the_point_task():
     cfg = dict(env="point", num_envs=16, iterations=20, eval_every=10, bc_steps=50, batch_size=128, eval_episodes=128)
     env = envs.make("point")
