@@ -136,7 +136,7 @@ class TrainConfig:
         check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "hidden", self.hidden, "one or more widths >= 1")
         check(self.horizon >= 1, "horizon", self.horizon, "an integer >= 1 (and < the episode length)")
         self.learner_config()  # the learner's own settings, each checked against its range
-        if self.algo == "pchid" and self.pchid_every == 0:  # resolved once, so a resume keeps the schedule
+        if learner.grows_horizon and self.pchid_every == 0:  # resolved once, so a resume keeps the schedule
             object.__setattr__(self, "pchid_every", max(1, self.iterations // (2 * self.horizon)))
         check(self.eval_every >= 1, "eval_every", self.eval_every, "an integer >= 1")
         check(

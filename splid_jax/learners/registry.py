@@ -29,6 +29,8 @@ class Learner:
     splits_envs: bool = False  # a single run may split its envs across devices (--num-devices)
     sweeps: tuple[str, ...] = ()  # run-config fields a sweep's members may hold apart (traced values)
     sets_num_envs: bool = False  # its settings fix the episodes per iteration: --num-envs is not read
+    grows_horizon: bool = False  # the learning horizon grows 1, 2, ..., H over the run (PCHID's curriculum)
+    clones_every_pair: bool = False  # every relabelled pair is cloned, without SELECT (GCSL)
     task_defaults: Mapping[str, Mapping[str, Any]] = dataclasses.field(default_factory=dict)
 
 
@@ -45,8 +47,10 @@ LEARNERS: dict[str, Learner] = {
     learner.name: learner
     for learner in (
         Learner("splid", "Algorithm 2", _TRAINER, **_IMITATION),
-        Learner("gcsl", "every relabelled pair cloned", _TRAINER, **_IMITATION),
-        Learner("pchid", "SPLID with the horizon grown 1..H, see --pchid-every", _TRAINER, **_IMITATION),
+        Learner("gcsl", "every relabelled pair cloned", _TRAINER, **_IMITATION, clones_every_pair=True),
+        Learner(
+            "pchid", "SPLID with the horizon grown 1..H, see --pchid-every", _TRAINER, **_IMITATION, grows_horizon=True
+        ),
         Learner(
             "her",
             "DDPG + HER",

@@ -14,7 +14,7 @@ from envs.base import GoalEnv
 from splid_jax.common.errors import check
 from splid_jax.common.networks import PolicyState, make_policy
 from splid_jax.config import TrainConfig
-from splid_jax.learners import gcsl
+from splid_jax.learners import gcsl, registry
 from splid_jax.learners.base import Chunked
 from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.bc import bc_epoch
@@ -44,8 +44,9 @@ class Hyper:
 
 
 class Trainer(Chunked):
-    """The behaviour-cloning learners as ``learners.base.Algorithm``s: SPLID (``cfg.algo`` "splid"), PCHID
-    (SPLID whose horizon grows from 1 to H) and GCSL (every relabelled pair cloned). Holds what is
+    """The behaviour-cloning learners as ``learners.base.Algorithm``s: SPLID, PCHID (SPLID whose
+    horizon grows from 1 to H) and GCSL (every relabelled pair cloned), as the registry describes
+    each (``grows_horizon``, ``clones_every_pair``). Holds what is
     static (task, network, optimiser, shapes); all state flows through arguments.
 
     With a ``mesh`` (one axis, ``devices.ENVS``) each device explores and SELECTs its slice of the
@@ -57,6 +58,7 @@ class Trainer(Chunked):
         check(isinstance(bc, ImitationConfig), "algo", cfg.algo, "a behaviour-cloning learner (splid, gcsl, pchid)")
         cfg.check_env(env)
         self.env, self.cfg, self.bc, self.name = env, cfg, bc, cfg.algo
+        self.learner = registry.get(cfg.algo)
         self.max_horizon = bc.horizon  # shapes; a sweep's members mask larger h through Hyper.horizon
         self.pchid_every = max(1, bc.pchid_every)  # TrainConfig resolves 0 for pchid
         self.policy = make_policy(
@@ -112,7 +114,7 @@ class Trainer(Chunked):
         horizon = self.horizon_at(ts.iteration, hyper)
         sigma = self.sigma_at(ts.iteration, hyper)
         seen, cands = self.explore_and_select(ts.policy, reset_keys, noise, sigma, horizon)
-        if cfg.algo == "gcsl":
+        if self.learner.clones_every_pair:
             cands = gcsl.relabel(env, seen, bc.gcsl_relabel, k_relabel)
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
         pstate = policy.update_normaliser(ts.policy, seen.obs, seen.achieved[:-1], ~seen.invalid[:-1])
@@ -165,9 +167,9 @@ class Trainer(Chunked):
         return seen, Candidates(*whole, jax.lax.psum(cands.replay_steps, ENVS))
 
     def _explore_and_select(self, pstate, reset_keys, noise, sigma, horizon) -> tuple[Seen, Candidates | None]:
-        env, cfg, bc = self.env, self.cfg, self.bc
+        env, bc = self.env, self.bc
         traj = rollout(env, self.policy, pstate, reset_keys, noise, sigma)
-        if cfg.algo == "gcsl":
+        if self.learner.clones_every_pair:
             return traj.seen(), None
         cands = select(
             env,
@@ -192,7 +194,7 @@ class Trainer(Chunked):
 
     def horizon_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
         """The learning horizon of this iteration: H, or PCHID's curriculum 1, 2, ..., H."""
-        if self.cfg.algo != "pchid":
+        if not self.learner.grows_horizon:
             return hyper.horizon
         return jnp.minimum(hyper.horizon, 1 + iteration // self.pchid_every).astype(jnp.int32)
 

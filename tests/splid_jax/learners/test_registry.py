@@ -45,6 +45,8 @@ def test_only_the_cloning_learners_split_a_run_and_sweep_sigma_and_h():
     splits = {name for name, x in registry.LEARNERS.items() if x.splits_envs}
     assert splits == {"splid", "gcsl", "pchid"}
     assert all(registry.get(n).sweeps == ("sigma", "horizon") for n in splits)
+    assert [n for n, x in registry.LEARNERS.items() if x.grows_horizon] == ["pchid"]
+    assert [n for n, x in registry.LEARNERS.items() if x.clones_every_pair] == ["gcsl"]
 
 
 def test_an_unknown_name_fails_naming_the_field():
