@@ -28,6 +28,9 @@ def test_every_name_builds_its_own_learner_from_its_own_settings():
         assert type(cfg.learner_config()) is settings
         algo = registry.make_algorithm(cfg, env)
         assert type(algo) is learner and algo.name == name
+        hyper = algo.hyper()  # what a sweep's members may hold apart: the learner's traced settings
+        traced = [f.name for f in dataclasses.fields(hyper)] if dataclasses.is_dataclass(hyper) else list(hyper)
+        assert tuple(traced) == registry.get(name).sweeps, name
 
 
 def test_a_learner_reads_its_settings_and_the_runs_and_ignores_the_others():
