@@ -71,7 +71,7 @@ def traces(env, trainer: Trainer, pstate, key, episodes: int) -> dict:
     }
 
 
-def run_arm(env_name: str, seeds: int, base: dict, fields: dict, trace_episodes: int) -> dict:
+def run_arm(env_name: str, seeds: int, base: dict, fields: dict, trace_episodes: int, first_seed: int = 1000) -> dict:
     merged = {**base, **fields}
     her = typed_fields(HerConfig, {k[4:]: v for k, v in merged.items() if k.startswith("her_")}, "set.her")
     train = typed_fields(TrainConfig, {k: v for k, v in merged.items() if not k.startswith("her_")}, "set")
@@ -79,7 +79,7 @@ def run_arm(env_name: str, seeds: int, base: dict, fields: dict, trace_episodes:
     with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
         env = envs.make(cfg.env, **cfg.env_overrides())
     trainer = HER(env, cfg, HerConfig(**her)) if cfg.algo == "her" else Trainer(env, cfg)
-    keys = jnp.stack([jax.random.PRNGKey(1000 + s) for s in range(seeds)])
+    keys = jnp.stack([jax.random.PRNGKey(first_seed + s) for s in range(seeds)])
     state = jax.jit(jax.vmap(trainer.init))(keys)
     hyper = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (seeds,)), trainer.hyper())
     chunk = jax.jit(jax.vmap(trainer.chunk))
@@ -112,6 +112,7 @@ def run_arm(env_name: str, seeds: int, base: dict, fields: dict, trace_episodes:
         "fields": fields,
         "config": cfg.to_json(),
         "seeds": seeds,
+        "first_seed": first_seed,
         "device": jax.devices()[0].device_kind,
         "date": time.strftime("%Y-%m-%d"),
         "compile_s": compile_s,
@@ -159,6 +160,7 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     p.add_argument("--env", default="push")
     p.add_argument("--seeds", type=int, default=5)
+    p.add_argument("--first-seed", type=int, default=1000, help="seeds FIRST..FIRST+SEEDS-1 (1000: the tuning seeds)")
     p.add_argument("--iterations", type=int, default=None)
     p.add_argument("--set", action="append", default=[], help="one arm: KEY=VALUE[,KEY=VALUE]")
     p.add_argument("--base", default="", help="fields shared by every arm: KEY=VALUE[,KEY=VALUE]")
@@ -179,7 +181,7 @@ def main() -> None:
         base["iterations"] = a.iterations
     results = []
     for spec in a.set or [""]:
-        r = run_arm(a.env, a.seeds, base, parse_set(spec), a.trace_episodes)
+        r = run_arm(a.env, a.seeds, base, parse_set(spec), a.trace_episodes, a.first_seed)
         name = "-".join(f"{k}{v}" for k, v in r["fields"].items()) or "default"
         with open(os.path.join(a.out, f"{a.env}-{name}.json"), "w") as fh:
             json.dump(r, fh)

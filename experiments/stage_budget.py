@@ -1,0 +1,181 @@
+"""Time budget per stage of a SPLID iteration and a HER cycle, at a task's default sizes.
+
+Each stage runs as its own jitted program on the state a short training left (so SELECT and HER's
+updates see realistic work): the medians of ``--repeats`` calls after a warm-up, with
+``block_until_ready``; compile time is the first call's time minus the median. The whole chunk
+(``eval_every`` iterations and one evaluation, the program training runs) is timed the same way,
+so the stages' sum can be held against it.
+
+    python experiments/stage_budget.py --env push --algos splid her --out budget.json
+
+``XLA_FLAGS`` is read as usual, so flag variants are measured by running the script once per
+variant (``--label`` names the variant in the output)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import sys
+import time
+
+import jax
+import jax.numpy as jnp
+
+from splid_jax.common.evaluation import evaluate
+from splid_jax.config import TrainConfig
+from splid_jax.learners.imitation import relabel_buffer
+from splid_jax.learners.imitation.bc import bc_epoch
+from splid_jax.learners.imitation.explore import draws, rollout
+from splid_jax.learners.registry import make_algorithm
+from splid_jax.learners.splid.select import select
+from splid_jax.runtime.loop import make_env
+
+
+def timed(fn, *args, repeats: int) -> tuple[dict, object]:
+    t0 = time.perf_counter()
+    out = jax.block_until_ready(fn(*args))
+    first = time.perf_counter() - t0
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = jax.block_until_ready(fn(*args))
+        times.append(time.perf_counter() - t0)
+    med = statistics.median(times)
+    return {"median_s": med, "compile_s": max(first - med, 0.0), "times_s": times}, out
+
+
+def warm(chunk, state, hyper, chunks: int):
+    """``chunks`` (>= 1) trained chunks, and the first one's time (compilation included)."""
+    t0 = time.perf_counter()
+    state, _ = jax.block_until_ready(chunk(state, hyper))
+    first_s = time.perf_counter() - t0
+    for _ in range(chunks - 1):
+        state, _ = jax.block_until_ready(chunk(state, hyper))
+    return state, first_s
+
+
+def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int, warm_chunks: int) -> dict:
+    cfg = TrainConfig(env=env_name, env_options=env_options, run_dir="/tmp/stage-budget")
+    env = make_env(cfg.env, **cfg.env_overrides())
+    algo = make_algorithm(cfg, env)
+    hyper = algo.hyper()
+    state = algo.init(jax.random.PRNGKey(0))
+    rows = {}
+    chunk = jax.jit(algo.chunk)
+    state, first_s = warm(chunk, state, hyper, warm_chunks)  # a policy that moves the object: SELECT sees real work
+    rows["chunk"], _ = timed(chunk, state, hyper, repeats=chunk_repeats)
+    rows["chunk"]["compile_s"] = max(first_s - rows["chunk"]["median_s"], 0.0)
+    rows["chunk"]["iterations"] = cfg.eval_every
+    pstate, key = state.policy, jax.random.PRNGKey(1)
+    sigma, horizon = hyper.sigma, hyper.horizon
+
+    def explore_fn(pstate, key):
+        keys, noise = draws(env, key, cfg.num_envs)
+        return rollout(env, algo.policy, pstate, keys, noise, sigma)
+
+    rows["explore"], traj = timed(jax.jit(explore_fn), pstate, key, repeats=repeats)
+
+    def select_fn(pstate, traj):
+        return select(
+            env, algo.policy, pstate, traj, algo.max_horizon, horizon, cfg.select, cfg.select_lanes,
+            hold=cfg.relabel in ("hold", "settle"), settle=cfg.relabel == "settle", radius=cfg.select_radius,
+        )  # fmt: skip
+
+    rows["select"], cands = timed(jax.jit(select_fn), pstate, traj, repeats=repeats)
+    rows["select"]["replay_steps"] = int(cands.replay_steps)
+    rows["select"]["valid"] = int(jnp.sum(cands.valid))
+
+    def insert_fn(buf, cands):
+        return relabel_buffer.insert(buf, cands.obs, cands.goal, cands.action, cands.accept)
+
+    rows["insert"], buf = timed(jax.jit(insert_fn), state.buffer, cands, repeats=repeats)
+
+    def bc_fn(pstate, opt_state, online, buf, key):
+        return bc_epoch(
+            algo.policy, algo.optimiser, pstate, opt_state, buf, key, cfg.bc_steps, cfg.batch_size,
+            online=online, ema=cfg.policy_ema,
+        )  # fmt: skip
+
+    rows["bc"], _ = timed(jax.jit(bc_fn), pstate, state.opt_state, state.online, buf, key, repeats=repeats)
+    rows["bc"]["steps"] = cfg.bc_steps
+
+    def eval_fn(pstate, key):
+        return evaluate(env, algo.policy, pstate, key, cfg.eval_episodes)
+
+    rows["evaluate"], _ = timed(jax.jit(eval_fn), pstate, key, repeats=repeats)
+    rows["evaluate"]["episodes"] = cfg.eval_episodes
+    shown = ("env", "env_options", "num_envs", "bc_steps", "eval_every")
+    return {"config": {k: cfg.to_json()[k] for k in shown}, "stages": rows}
+
+
+def her_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int, warm_chunks: int) -> dict:
+    cfg = TrainConfig(env=env_name, env_options=env_options, algo="her", run_dir="/tmp/stage-budget-her")
+    env = make_env(cfg.env, **cfg.env_overrides())
+    algo = make_algorithm(cfg, env)
+    state = algo.init(jax.random.PRNGKey(0))
+    rows = {}
+    chunk = jax.jit(algo.chunk)
+    state, first_s = warm(chunk, state, {}, warm_chunks)
+    rows["chunk"], _ = timed(chunk, state, {}, repeats=chunk_repeats)
+    rows["chunk"]["compile_s"] = max(first_s - rows["chunk"]["median_s"], 0.0)
+    rows["chunk"]["iterations"] = cfg.eval_every
+    key = jax.random.PRNGKey(1)
+    rows["explore"], (episodes, valid, _) = timed(jax.jit(algo.explore), state.policy, key, repeats=repeats)
+
+    def store_fn(hs, episodes, valid, key):
+        from splid_jax.learners.her.episode_buffer import buffer_insert
+
+        return hs.replace(
+            buffer=buffer_insert(hs.buffer, episodes, valid),
+            policy=algo.update_normaliser(hs.policy, episodes, valid, key),
+        )
+
+    rows["store_and_normalise"], state = timed(jax.jit(store_fn), state, episodes, valid, key, repeats=repeats)
+
+    def updates_fn(hs, key):
+        return jax.lax.scan(algo.train_step, hs, jax.random.split(key, algo.her.n_batches))
+
+    rows["updates"], _ = timed(jax.jit(updates_fn), state, key, repeats=repeats)
+    rows["updates"]["steps"] = algo.her.n_batches
+
+    def eval_fn(pstate, key):
+        return evaluate(env, algo.policy, pstate, key, cfg.eval_episodes)
+
+    rows["evaluate"], _ = timed(jax.jit(eval_fn), state.policy, key, repeats=repeats)
+    rows["evaluate"]["episodes"] = cfg.eval_episodes
+    return {"config": {k: cfg.to_json()[k] for k in ("env", "env_options", "num_envs", "eval_every")}, "stages": rows}
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
+    p.add_argument("--env", default="push")
+    p.add_argument("--env-options", default="", help="task fields as KEY=VALUE[,KEY=VALUE...]")
+    p.add_argument("--algos", nargs="+", default=["splid", "her"], choices=["splid", "her"])
+    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--chunk-repeats", type=int, default=3, help="timed calls of the whole chunk")
+    p.add_argument("--warm-chunks", type=int, default=1, help="chunks trained before timing (>= 1)")
+    p.add_argument("--label", default="default", help="the variant's name (e.g. its XLA flags)")
+    p.add_argument("--out", required=True)
+    args = p.parse_args()
+    result = {
+        "label": args.label,
+        "xla_flags": os.environ.get("XLA_FLAGS", ""),
+        "device": jax.devices()[0].device_kind,
+        "jax": jax.__version__,
+        "date": time.strftime("%Y-%m-%d"),
+        "command": " ".join(sys.argv),
+    }
+    budgets = {"splid": splid_budget, "her": her_budget}
+    for name in args.algos:
+        sizes = (args.repeats, args.chunk_repeats, max(1, args.warm_chunks))
+        result[name] = budgets[name](args.env, args.env_options, *sizes)
+        with open(args.out, "w") as fh:  # after each learner, so a cut call keeps what it measured
+            json.dump(result, fh, indent=2)
+        for stage, row in result[name]["stages"].items():
+            print(f"{args.label} {name} {stage}: {row['median_s'] * 1e3:.1f} ms (compile {row['compile_s']:.1f} s)")
+
+
+if __name__ == "__main__":
+    main()
