@@ -17,28 +17,6 @@ import jax.numpy as jnp
 from flax import struct
 
 
-class InvalidConfig(ValueError):
-    """A configuration value is out of its allowed range; the message names field and range."""
-
-    def __init__(self, field: str, value: Any, allowed: str):
-        self.field = field
-        self.value = value
-        self.allowed = allowed
-        super().__init__(f"invalid {field}={value!r}: must be {allowed}")
-
-
-def check(ok: bool, field: str, value: Any, allowed: str) -> None:
-    """Raise ``InvalidConfig`` naming ``field`` unless ``ok``."""
-    if not ok:
-        raise InvalidConfig(field, value, allowed)
-
-
-def check_integer(field: str, value: Any, low: int, high: int | None = None) -> None:
-    """``check`` for an integer field in [low, high] (no upper bound when ``high`` is None)."""
-    ok = isinstance(value, int) and low <= value and (high is None or value <= high)
-    check(ok, field, value, f"an integer >= {low}" if high is None else f"an integer in [{low}, {high}]")
-
-
 @struct.dataclass
 class State:
     """One step of one episode; batch it with ``jax.vmap``."""
@@ -122,10 +100,9 @@ def flag_invalid(state: State) -> State:
     return state.replace(invalid=state.invalid | bad)
 
 
-# XLA:CPU (jaxlib 0.10.2, 2-core machine, 2026-11-23) parks every thread and never returns when a
-# vmapped MJX step of about 1,000 envs or more runs inside a loop: 750 envs ran, 1,000 did not, with
-# or without multi-threaded Eigen or async dispatch. On the CPU the batch is therefore stepped in
-# slices of this many envs; each env's step is independent, so only the schedule changes.
+# XLA:CPU can hang when a vmapped MJX step of about 1,000 envs or more runs inside a loop
+# (experiments/NOTES.md, "CPU step slices"). On the CPU the batch is therefore stepped in slices of
+# this many envs; each env's step is independent, so only the schedule changes.
 CPU_STEP_SLICE = 512
 
 

@@ -9,7 +9,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from envs.base import GoalEnv, State, check, flag_invalid
+from envs.base import GoalEnv, State, flag_invalid
+from splid_jax.common.errors import check
 
 BOUND = 5.0
 

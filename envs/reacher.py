@@ -16,7 +16,8 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs.base import GoalEnv, State, check, check_integer, flag_invalid
+from envs.base import GoalEnv, State, flag_invalid
+from splid_jax.common.errors import check, check_integer
 
 LINKS = (0.1, 0.11)  # shoulder to elbow, elbow to fingertip (Gym's fingertip body sits at 0.11)
 FINGERTIP_Z = 0.01

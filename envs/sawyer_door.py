@@ -32,7 +32,8 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs.base import GoalEnv, State, check, check_integer, flag_invalid
+from envs.base import GoalEnv, State, flag_invalid
+from splid_jax.common.errors import check, check_integer
 
 GOAL_MAX = 0.83  # the largest goal angle (GCSL's multiworld settings), rad
 HINGE_MAX = 1.0  # the hinge's upper limit, rad

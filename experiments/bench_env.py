@@ -41,6 +41,8 @@ with contextlib.redirect_stdout(io.StringIO()):  # mujoco.mjx prints a note abou
 
 import envs  # noqa: E402
 from envs.base import step_batch  # noqa: E402
+from splid_jax.common.errors import InvalidConfig  # noqa: E402
+from splid_jax.common.values import parse_overrides  # noqa: E402
 
 TASKS = ["reach", "push", "slide", "pick_and_place", "reacher", "sawyer_door"]
 GPU_BATCHES = [1024, 2048, 4096, 8192, 16384, 32768, 65536]
@@ -52,8 +54,8 @@ def parse_variant(text: str) -> tuple[str, dict]:
     if text in ("", "default"):
         return "default", {}
     try:
-        return text, envs.parse_overrides(text, field="variant")
-    except envs.InvalidConfig as e:
+        return text, parse_overrides(text, field="variant")
+    except InvalidConfig as e:
         raise argparse.ArgumentTypeError(str(e)) from e
 
 
@@ -171,7 +173,7 @@ def main(argv=None) -> int:
         for _, overrides in variants:
             try:
                 envs.make(task, **overrides)
-            except envs.InvalidConfig as e:
+            except InvalidConfig as e:
                 p.error(str(e))
 
     device = str(jax.devices()[0])

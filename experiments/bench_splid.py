@@ -26,10 +26,11 @@ import jax
 import jax.numpy as jnp
 
 from splid_jax.config import TrainConfig
-from splid_jax.explore import explore
-from splid_jax.loop import make_algorithm, make_env
-from splid_jax.select import num_lanes, select
-from splid_jax.trainer import Trainer
+from splid_jax.learners.imitation.explore import draws, rollout
+from splid_jax.learners.registry import make_algorithm
+from splid_jax.learners.splid.select import num_lanes, select
+from splid_jax.learners.splid.trainer import Trainer
+from splid_jax.runtime.loop import make_env
 
 
 def timed(fn, *args, repeats: int):
@@ -65,7 +66,8 @@ def bench_select(env, cfg: TrainConfig, device, repeats: int, pstate=None) -> di
         if pstate is None:
             pstate = trainer.init(jax.random.PRNGKey(0)).policy
         pstate = jax.device_put(pstate, device)
-        traj = jax.jit(lambda ps, k: explore(env, trainer.policy, ps, k, cfg.num_envs, jnp.float32(cfg.sigma)))(
+        sigma = jnp.float32(cfg.sigma)
+        traj = jax.jit(lambda ps, k: rollout(env, trainer.policy, ps, *draws(env, k, cfg.num_envs), sigma))(
             pstate, jax.random.PRNGKey(1)
         )
         fn = jax.jit(

@@ -25,9 +25,11 @@ import numpy as np
 
 import envs
 from envs.base import step_batch
-from splid_jax.config import TrainConfig, typed_fields
-from splid_jax.her import HER, HerConfig
-from splid_jax.trainer import Trainer
+from splid_jax.common.values import parse_overrides, typed_fields
+from splid_jax.config import TrainConfig
+from splid_jax.learners.her.config import HerConfig
+from splid_jax.learners.her.learner import HER
+from splid_jax.learners.splid.trainer import Trainer
 
 
 def traces(env, trainer: Trainer, pstate, key, episodes: int) -> dict:
@@ -122,7 +124,7 @@ def run_arm(env_name: str, seeds: int, base: dict, fields: dict, trace_episodes:
 
 def parse_set(text: str) -> dict:
     """An arm's fields as written (they name its file); typed when its configs are built."""
-    return envs.parse_overrides(text, "set")
+    return parse_overrides(text, "set")
 
 
 def figure(results: list[dict], out: str) -> None:

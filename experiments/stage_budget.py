@@ -23,13 +23,14 @@ import time
 import jax
 import jax.numpy as jnp
 
-from splid_jax import relabel_buffer
-from splid_jax.bc import bc_epoch
+from splid_jax.common.evaluation import evaluate
 from splid_jax.config import TrainConfig
-from splid_jax.evaluate import evaluate
-from splid_jax.explore import draws, rollout
-from splid_jax.loop import make_algorithm, make_env
-from splid_jax.select import select
+from splid_jax.learners.imitation import relabel_buffer
+from splid_jax.learners.imitation.bc import bc_epoch
+from splid_jax.learners.imitation.explore import draws, rollout
+from splid_jax.learners.registry import make_algorithm
+from splid_jax.learners.splid.select import select
+from splid_jax.runtime.loop import make_env
 
 
 def timed(fn, *args, repeats: int) -> tuple[dict, object]:
@@ -124,7 +125,7 @@ def her_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int
     rows["explore"], (episodes, valid, _) = timed(jax.jit(algo.explore), state.policy, key, repeats=repeats)
 
     def store_fn(hs, episodes, valid, key):
-        from splid_jax.her import buffer_insert
+        from splid_jax.learners.her.episode_buffer import buffer_insert
 
         return hs.replace(
             buffer=buffer_insert(hs.buffer, episodes, valid),

@@ -34,7 +34,7 @@ class Parser(argparse.ArgumentParser):
         super().__init__(allow_abbrev=False, **kw)
 
     def format_help(self) -> str:
-        listings = {"env_options": task_fields, "her_options": her_fields, "es_options": es_fields}
+        listings = {"env_options": task_fields, **learner_option_fields()}
         for action in self._actions:
             if action.dest in listings and not getattr(action, "fields_listed", False):
                 action.help = f"{action.help}. Fields and defaults: {listings[action.dest]()}".replace("%", "%%")
@@ -42,18 +42,23 @@ class Parser(argparse.ArgumentParser):
         return super().format_help()
 
 
-def her_fields() -> str:
-    from splid_jax.config import option_fields
-    from splid_jax.her import HerConfig
+def learner_option_fields() -> dict:
+    """For each learner whose settings travel as KEY=VALUE text (``--her-options``), its fields and defaults."""
+    from splid_jax.common.values import option_fields
+    from splid_jax.learners import registry
 
-    return option_fields(HerConfig)
+    return {
+        x.options: lambda x=x: option_fields(x.settings) for x in registry.LEARNERS.values() if x.options is not None
+    }
 
 
-def es_fields() -> str:
-    from splid_jax.config import option_fields
-    from splid_jax.es import EsConfig
+def readers(name: str) -> str | None:
+    """The learners that read run-config field ``name``, as an argument group's title; None for the
+    run's own fields, which every learner reads."""
+    from splid_jax.learners import registry
 
-    return option_fields(EsConfig)
+    who = [x.name for x in registry.LEARNERS.values() if name in x.reads or name == x.options]
+    return f"read only by {', '.join(who)}" if who else None
 
 
 def task_fields() -> str:
@@ -65,7 +70,7 @@ def task_fields() -> str:
     for name in envs.names():
         with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
             cls = envs.task_class(name)
-        defaults = {f.name: f.default for f in dataclasses.fields(cls)}
+        defaults = {f.name: _marked(f) for f in dataclasses.fields(cls)}
         if previous is not None and previous[1].keys() == defaults.keys():
             diff = {k: v for k, v in defaults.items() if v != previous[1][k]}
             shown = ", ".join(f"{k}={v}" for k, v in diff.items())
@@ -74,6 +79,11 @@ def task_fields() -> str:
             parts.append(f"{name}: " + ", ".join(f"{k}={v}" for k, v in defaults.items()))
             previous = (name, defaults)
     return "; ".join(parts)
+
+
+def _marked(f: dataclasses.Field) -> str:
+    """A task field's default, marked when the field is an experimental option."""
+    return f"{f.default} (experimental)" if f.metadata.get("experimental") else f"{f.default}"
 
 
 def _int_tuple(text: str) -> tuple[int, ...]:
@@ -94,7 +104,9 @@ def add_config_flags(
     per_algo: dict[str, dict[str, dict]] | None = None,
 ) -> None:
     """One flag per field (less ``exclude``); every default is None so that explicit values can be told
-    apart. ``per_algo``: a learner's own defaults per task, shown after the task defaults they replace."""
+    apart. ``per_algo``: a learner's own defaults per task, shown after the task defaults they replace.
+    Fields that only some learners read are listed in a group per set of learners (``readers``)."""
+    groups: dict[str, argparse._ArgumentGroup] = {}
     for f in dataclasses.fields(cls):
         if f.name in exclude:
             continue
@@ -111,20 +123,24 @@ def add_config_flags(
                         values.setdefault(_show(d[f.name]), []).append(task)
                 shown += "".join(f"; {algo} on {', '.join(ts)}: {v}" for v, ts in values.items())
             help_text += f" (default per task: {shown})"
+        title = readers(f.name)
+        where = parser if title is None else groups.setdefault(title, parser.add_argument_group(title))
         if f.type == "bool":
-            parser.add_argument(flag, action=argparse.BooleanOptionalAction, default=None, help=help_text)
+            where.add_argument(flag, action=argparse.BooleanOptionalAction, default=None, help=help_text)
         else:
-            parser.add_argument(flag, type=_TYPES[f.type], default=None, help=help_text, metavar=f.name.upper())
+            where.add_argument(flag, type=_TYPES[f.type], default=None, help=help_text, metavar=f.name.upper())
 
 
 def refuse_unread(given: dict, algo: str) -> None:
     """A setting given on the command line that ``algo`` does not read is a mistake, not a no-op."""
-    from envs.base import InvalidConfig
-    from splid_jax.config import NOT_READ
+    from splid_jax.common.errors import InvalidConfig
+    from splid_jax.learners import registry
 
-    for name in NOT_READ.get(algo, ()):
+    learner = registry.get(algo)
+    for name in registry.ignores(algo):
         if name in given:
-            allowed = f"unset with --algo {algo}, which does not read it (its own settings: --{algo}-options)"
+            own = f"--{learner.options.replace('_', '-')}" if learner.options else "the flags of its group in --help"
+            allowed = f"unset with --algo {algo}, which does not read it (its own settings: {own})"
             raise InvalidConfig(name, given[name], allowed)
 
 
@@ -173,7 +189,7 @@ def add_launch_flags(parser: argparse.ArgumentParser) -> None:
 def start_processes(ns: argparse.Namespace) -> None:
     """Joins the run's processes (``jax.distributed``) before any other JAX use; bad launch options
     raise ``InvalidConfig`` before anything waits for a peer."""
-    from splid_jax import multihost
+    from splid_jax.runtime import multihost
 
     multihost.start(multihost.launch(ns.coordinator, ns.num_processes, ns.process_id))
 

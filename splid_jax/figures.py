@@ -1,6 +1,6 @@
 """``python -m splid_jax.figures FIG --env ENV``: the paper's figures, each from one command.
 
-Every series is trained through the one host loop (``splid_jax.loop``) as one vmapped sweep whose
+Every series is trained through the one host loop (``splid_jax.runtime.loop``) as one vmapped sweep whose
 members are the seeds (and, for Figures 4 and 5, the values of H or sigma), in OUT/METHOD/. Every
 method gets the same budget of exploration episodes: its iterations are the budget over its
 episodes per iteration, rounded to whole compiled chunks, and the CSV says what each one ran. The
@@ -34,10 +34,13 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.ticker import EngFormatter  # noqa: E402
 
 import envs  # noqa: E402
-from envs.base import InvalidConfig, check  # noqa: E402
-from splid_jax import checkpoint, loop, plot, progress  # noqa: E402
+from splid_jax import plot  # noqa: E402
 from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache  # noqa: E402
-from splid_jax.config import NOT_READ, TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.common.errors import InvalidConfig, check  # noqa: E402
+from splid_jax.common.values import read_value, typed_value  # noqa: E402
+from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.learners import registry  # noqa: E402
+from splid_jax.runtime import checkpoint, loop, progress  # noqa: E402
 
 SPEC = "figure.json"  # the figure's command, device, date and what each method ran
 
@@ -102,7 +105,7 @@ QUICK_METHOD_FIELDS: dict[str, dict[str, Any]] = {
 def reads(algo: str, field: str) -> bool:
     """Whether ``algo`` reads a TrainConfig field, so that a setting given for every method skips
     those that do not (ES's num_envs is its population's episodes)."""
-    return field not in NOT_READ.get(algo, ()) and not (algo == "es" and field == "num_envs")
+    return registry.reads(algo, field)
 
 
 def default_budget(env: str) -> int:
@@ -147,8 +150,8 @@ def parse_sets(items: Sequence[str], methods: Sequence[str]) -> dict[str | None,
         if kind.startswith("tuple"):  # one field per --set, so its commas are the tuple's
             value = value.replace(",", ":")
         elif kind != "str":
-            value = envs.read_value(value)
-        out.setdefault(method or None, {})[name] = envs.typed_value(name, kind, value)
+            value = read_value(value)
+        out.setdefault(method or None, {})[name] = typed_value(name, kind, value)
     return out
 
 
@@ -203,7 +206,7 @@ def plan(
             made[options] = loop.make_env(env_name, **probe.env_overrides())
         env = made[options]
         probe.check_env(env)
-        per_iteration = loop.make_algorithm(probe, env).counters(1, 0)["episodes"]
+        per_iteration = registry.make_algorithm(probe, env).counters(1, 0)["episodes"]
         chunks = max(1, math.floor(budget / (per_iteration * probe.eval_every) + 0.5))  # nearest, half up
         # pchid_every left at 0 is resolved again, so PCHID's schedule follows the figure's iterations
         base = dataclasses.replace(
@@ -221,7 +224,7 @@ def plan(
         )
         for lane in lanes:
             lane.check_env(env)
-        loop.make_algorithm(base, env)  # the run's own settings
+        registry.make_algorithm(base, env)  # the run's own settings
         plans.append(Plan(name, base, lanes, per_iteration))
     return plans
 

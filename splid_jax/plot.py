@@ -20,7 +20,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg
 
-from splid_jax import progress
+from splid_jax.runtime import progress
 
 DESCRIPTION = (
     "Learning curves of one or more runs: evaluation success (solid: at any step, dashed: at the final step) "

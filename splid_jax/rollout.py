@@ -14,11 +14,14 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from envs.base import InvalidConfig, step_batch
-from splid_jax import checkpoint
+from envs.base import step_batch
 from splid_jax.cli import add_compile_cache_flag, use_compile_cache
+from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
-from splid_jax.loop import env_settings, make_algorithm, make_env
+from splid_jax.learners.registry import make_algorithm
+from splid_jax.runtime import checkpoint
+from splid_jax.runtime.loop import make_env
+from splid_jax.runtime.run_files import env_settings
 
 DESCRIPTION = (
     "Roll a run's deterministic policy out, report its success and draw the episodes: their paths, "

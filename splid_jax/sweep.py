@@ -1,6 +1,6 @@
 """``python -m splid_jax.sweep``: seeds x sigma x H as ONE compiled program.
 
-Every member is a lane of ``jax.vmap`` over the chunk function (``splid_jax.loop``): seeds differ by
+Every member is a lane of ``jax.vmap`` over the chunk function (``splid_jax.runtime.loop``): seeds differ by
 PRNG key, sigma and H by the traced hyper-parameters (H masks candidates up to the largest H of the
 grid), so a grid costs one compilation and runs in lock-step on the device. Each member writes its
 own config.json and metrics.jsonl under RUN_DIR/<member>; the members' stacked state is checkpointed
@@ -21,8 +21,7 @@ import os  # noqa: E402
 import re  # noqa: E402
 import sys  # noqa: E402
 
-from envs.base import InvalidConfig, check  # noqa: E402
-from splid_jax import checkpoint, loop, multihost, plot, progress  # noqa: E402
+from splid_jax import plot  # noqa: E402
 from splid_jax.cli import (  # noqa: E402
     Parser,
     add_compile_cache_flag,
@@ -33,8 +32,17 @@ from splid_jax.cli import (  # noqa: E402
     start_processes,
     use_compile_cache,
 )
-from splid_jax.config import ALGO_DEFAULTS, TASK_DEFAULTS, TrainConfig  # noqa: E402
-from splid_jax.loop import RunStopped, make_env  # noqa: E402
+from splid_jax.common.errors import InvalidConfig, check  # noqa: E402
+from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.learners import registry  # noqa: E402
+from splid_jax.runtime import (  # noqa: E402
+    checkpoint,
+    loop,
+    multihost,
+    progress,
+    run_files,  # noqa: E402
+)
+from splid_jax.runtime.loop import RunStopped, make_env  # noqa: E402
 
 
 @dataclasses.dataclass(frozen=True)
@@ -108,7 +116,7 @@ def build_parser() -> Parser:
     )
     # --sigmas and --horizons replace the single values
     add_config_flags(
-        parser, TrainConfig, TASK_DEFAULTS, exclude=frozenset({"sigma", "horizon"}), per_algo=ALGO_DEFAULTS
+        parser, TrainConfig, TASK_DEFAULTS, exclude=frozenset({"sigma", "horizon"}), per_algo=registry.task_defaults()
     )
     parser.add_argument("--seeds", type=int, default=4, help="seeds per grid point (default: 4)")
     parser.add_argument("--sigmas", default="1.0", help="comma-separated sigma values (default: 1.0)")
@@ -124,18 +132,18 @@ def build_parser() -> Parser:
 def resume_configs(run_dir: str, given: dict) -> tuple[TrainConfig, list[TrainConfig]]:
     """The sweep's and its members' configs from RUN_DIR/sweep.json; only ``MAY_CHANGE_ON_RESUME``
     fields (iterations, checkpoint_every) may be given anew."""
-    changed = [k for k in given if k not in loop.MAY_CHANGE_ON_RESUME]
+    changed = [k for k in given if k not in run_files.MAY_CHANGE_ON_RESUME]
     if changed:
         raise InvalidConfig(changed[0], given[changed[0]], "as in the sweep being resumed (only iterations may change)")
     try:
-        with open(os.path.join(run_dir, loop.SWEEP)) as fh:
+        with open(os.path.join(run_dir, run_files.SWEEP)) as fh:
             saved = json.load(fh)
         base = TrainConfig(**{**saved["config"], **given, "run_dir": run_dir})
         lanes = [
             TrainConfig(**{**m, **given, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in saved["members"]
         ]
     except (OSError, json.JSONDecodeError, KeyError, TypeError):
-        raise InvalidConfig("resume", run_dir, f"a sweep directory holding its {loop.SWEEP}") from None
+        raise InvalidConfig("resume", run_dir, f"a sweep directory holding its {run_files.SWEEP}") from None
     return base, lanes
 
 

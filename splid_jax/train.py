@@ -1,4 +1,4 @@
-"""``python -m splid_jax.train --env ENV``: train one run through the host loop (``splid_jax.loop``).
+"""``python -m splid_jax.train --env ENV``: train one run through the host loop (``splid_jax.runtime.loop``).
 
 Exit codes: 0 done (or already complete), 2 a mistake in the command line (one line naming the
 field, nothing written), 3 stopped (NaN, unreadable checkpoint), 130 Ctrl-C, 143 SIGTERM; a stop
@@ -18,8 +18,6 @@ import os  # noqa: E402
 import sys  # noqa: E402
 
 import envs  # noqa: E402
-from envs.base import InvalidConfig  # noqa: E402
-from splid_jax import checkpoint, loop, multihost, progress  # noqa: E402
 from splid_jax.cli import (  # noqa: E402
     Parser,
     add_compile_cache_flag,
@@ -30,8 +28,12 @@ from splid_jax.cli import (  # noqa: E402
     start_processes,
     use_compile_cache,
 )
-from splid_jax.config import ALGO_DEFAULTS, PROVENANCE, TASK_DEFAULTS, TrainConfig  # noqa: E402
-from splid_jax.loop import MAY_CHANGE_ON_RESUME, RunStopped, env_settings, make_env  # noqa: E402
+from splid_jax.common.errors import InvalidConfig  # noqa: E402
+from splid_jax.config import PROVENANCE, TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.learners import registry  # noqa: E402
+from splid_jax.runtime import checkpoint, loop, multihost, progress  # noqa: E402
+from splid_jax.runtime.loop import RunStopped, make_env  # noqa: E402
+from splid_jax.runtime.run_files import MAY_CHANGE_ON_RESUME, env_settings  # noqa: E402
 
 __all__ = ["RunStopped", "build_parser", "config_from_cli", "env_settings", "main", "make_env", "run"]
 
@@ -49,7 +51,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Exit codes: 0 done, 2 bad input (nothing written), 3 stopped on NaN or an unreadable checkpoint, "
         "130 Ctrl-C, 143 SIGTERM (both keep the newest whole state as a checkpoint for --resume).",
     )
-    add_config_flags(parser, TrainConfig, TASK_DEFAULTS, per_algo=ALGO_DEFAULTS)
+    add_config_flags(parser, TrainConfig, TASK_DEFAULTS, per_algo=registry.task_defaults())
     parser.add_argument("--resume", metavar="RUN_DIR", help="continue the run saved in RUN_DIR (its config.json)")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_compile_cache_flag(parser)

@@ -32,8 +32,9 @@ import jax.numpy as jnp
 from flax import struct
 
 from envs import small_cholesky
-from envs.base import GoalEnv, State, check, check_integer, flag_invalid
+from envs.base import GoalEnv, State, flag_invalid
 from envs.fetch import models
+from splid_jax.common.errors import check, check_integer
 
 MIN_OBJECT_DISTANCE = 0.1  # the object starts at least this far from the gripper in xy
 _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4) ** 64 ~ 2e-7
@@ -77,6 +78,11 @@ def quat_rotate(q: jax.Array, v: jax.Array) -> jax.Array:
     return v + 2.0 * jnp.cross(u, jnp.cross(u, v) + w * v)
 
 
+def experimental(default):
+    """A task field ``--help`` marks as experimental: the parity study's variants, training-only starts."""
+    return dataclasses.field(default=default, metadata={"experimental": True})
+
+
 @dataclasses.dataclass(frozen=True)
 class _FetchTask(GoalEnv):
     """Shared machinery; subclasses set the scene and the goal distribution."""
@@ -89,14 +95,20 @@ class _FetchTask(GoalEnv):
     substeps: int = 10
     iterations: int = 4
     ls_iterations: int = 4
-    table: str = "plane"  # the table's collision shape: its top face as a plane, or the reference's box
-    finger: str = "box"  # the closed finger block's collision shape (Push: box or capsule, see models.py)
-    cholesky: str = "unrolled"  # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
-    workspace: str = "arm"  # where the gripper target may go: the box and the reference arm's reach, or the box
-    drive: str = "pd"  # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
-    # Training only: this share of resets starts with the object between the closed fingers (PickAndPlace),
-    # HER 2017's protocol; evaluation_task() resets it to 0, so success is always measured from standard starts.
-    grasped_starts: float = 0.0
+    # Parity-study options (experimental): the reference's variants of parts of the physics.
+    # the table's collision shape: its top face as a plane, or the reference's box
+    table: str = experimental("plane")
+    # the closed finger block's collision shape (Push: box or capsule, see models.py)
+    finger: str = experimental("box")
+    # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
+    cholesky: str = experimental("unrolled")
+    # where the gripper target may go: the box and the reference arm's reach, or the box
+    workspace: str = experimental("arm")
+    # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
+    drive: str = experimental("pd")
+    # Training only (experimental): this share of resets starts with the object between the closed fingers
+    # (PickAndPlace), HER 2017's protocol; evaluation_task() resets it to 0: success is measured from standard starts.
+    grasped_starts: float = experimental(0.0)
 
     kind = ""  # models.KINDS entry
     has_object = True

@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 import envs
-from envs.base import InvalidConfig
 from envs.fetch import models, scripted, tasks
+from splid_jax.common.errors import InvalidConfig
 
 NAMES = ["reach", "push", "slide", "pick_and_place"]
 K = 20  # restore point of the replay test

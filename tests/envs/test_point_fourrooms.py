@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import envs
-from envs.base import InvalidConfig
+from splid_jax.common.errors import InvalidConfig
 
 
 @pytest.fixture(scope="module")

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import envs
-from envs.base import InvalidConfig
 from envs.reacher import fingertip, scripted
+from splid_jax.common.errors import InvalidConfig
 
 N = 8
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import envs
-from envs.base import InvalidConfig
 from envs.sawyer_door import GOAL_MAX, HINGE_MAX, WORKSPACE, scripted
+from splid_jax.common.errors import InvalidConfig
 
 N = 8
 

@@ -3,7 +3,7 @@ import json
 
 import pytest
 
-from envs.base import InvalidConfig
+from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 
 

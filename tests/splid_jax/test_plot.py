@@ -46,6 +46,23 @@ def test_two_runs_default_output(tmp_path, capsys):
     assert capsys.readouterr().out.strip() == str(a / "curves.png")
 
 
+def test_each_panel_plots_the_runs_smoothed_measures_against_its_axis(tmp_path):
+    runs = [plot.load_run(make_run(tmp_path, "a", 0)), plot.load_run(make_run(tmp_path, "b", 1, select=False))]
+    fig = plot.figure(runs, k=3)
+    panels = fig.axes[:6]  # rows: success, return; columns: episodes, env steps, wall clock
+    for col, x_key in enumerate(("episodes", "env_steps", "wall_s")):
+        success, ret = panels[col], panels[3 + col]
+        for i, run in enumerate(runs):
+            any_step, final_step = success.get_lines()[2 * i : 2 * i + 2]
+            (returns,) = ret.get_lines()[i : i + 1]
+            for line in (any_step, final_step, returns):
+                np.testing.assert_array_equal(line.get_xdata(), run.columns[x_key])
+            np.testing.assert_allclose(any_step.get_ydata(), plot.smooth(run.columns["eval_success"], 3))
+            np.testing.assert_allclose(final_step.get_ydata(), plot.smooth(run.columns["eval_success_final"], 3))
+            np.testing.assert_allclose(returns.get_ydata(), plot.smooth(run.columns["eval_return"], 3))
+            assert any_step.get_linestyle() == "-" and final_step.get_linestyle() == "--"
+
+
 def test_group_and_out(tmp_path):
     dirs = [make_run(tmp_path, f"s{s}", s, sigma=0.5) for s in range(3)]
     dirs += [make_run(tmp_path, f"h{s}", s, sigma=1.0, n=10) for s in range(2)]

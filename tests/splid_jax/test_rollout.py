@@ -6,11 +6,12 @@ import mujoco
 import numpy as np
 import pytest
 
-from splid_jax import checkpoint, rollout
+from splid_jax import rollout
 from splid_jax.config import TrainConfig
+from splid_jax.learners.splid.trainer import Trainer
+from splid_jax.runtime import checkpoint
 from splid_jax.train import env_settings, make_env
 from splid_jax.train import main as train_main
-from splid_jax.trainer import Trainer
 
 
 @pytest.fixture(scope="module")
@@ -205,8 +206,8 @@ def test_paths_figure_has_a_title_and_a_legend():
 )
 def test_rollout_acts_as_the_evaluation_of_a_her_or_es_run(tmp_path, capsys, algo, options):
     """HER's actor and ES's search mean both sit at ``state.policy``; rollout rolls what the loop evaluates."""
-    from splid_jax.evaluate import evaluate
-    from splid_jax.loop import make_algorithm
+    from splid_jax.common.evaluation import evaluate
+    from splid_jax.learners.registry import make_algorithm
 
     run_dir = tmp_path / "run"
     cfg = TrainConfig(env="point", algo=algo, iterations=1, eval_every=1, hidden=(8,) if algo == "es" else None,

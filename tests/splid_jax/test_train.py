@@ -2,6 +2,7 @@
 any moment, NaN, corrupt and mismatched checkpoints. All on the point task, in subprocesses where a
 signal is real."""
 
+import dataclasses
 import json
 import os
 import signal
@@ -13,10 +14,11 @@ import jax
 import numpy as np
 import pytest
 
-from splid_jax import checkpoint
 from splid_jax.config import TrainConfig
+from splid_jax.learners import registry
+from splid_jax.learners.splid.trainer import Trainer
+from splid_jax.runtime import checkpoint
 from splid_jax.train import RunStopped, main, run
-from splid_jax.trainer import Trainer
 
 TINY = ["--env", "point", "--num-envs", "8", "--eval-episodes", "16", "--bc-steps", "40", "--batch-size", "64",
         "--hidden", "32,32", "--eval-every", "5"]  # fmt: skip
@@ -113,13 +115,23 @@ def test_run_dir_that_is_a_file_is_refused(tmp_path, capsys):
 
 
 def test_help_documents_every_flag(capsys):
+    """Every field of the run config is a flag with its help line, and every field of a learner's own
+    settings is listed with its default under its learner's group."""
     with pytest.raises(SystemExit) as exc:
         main(["--help"])
     assert exc.value.code == 0
-    out = capsys.readouterr().out
-    for flag in ["--env", "--seed", "--iterations", "--num-envs", "--sigma", "--horizon", "--no-select", "--run-dir",
-                 "--resume"]:  # fmt: skip
-        assert flag in out
+    out = " ".join(capsys.readouterr().out.split())
+    for f in dataclasses.fields(TrainConfig):
+        flag = "--" + f.name.replace("_", "-")
+        help_start = " ".join(f.metadata["help"].split()[:4])
+        assert f"{flag} " in out and help_start in out, f.name
+    assert "--no-select" in out and "--resume" in out
+    for learner in registry.LEARNERS.values():
+        if learner.options is not None:
+            for f in dataclasses.fields(learner.settings):
+                default = ",".join(map(str, f.default)) if isinstance(f.default, tuple) else f.default
+                assert f"{f.name}={default} (" in out, f"{learner.name}.{f.name}"
+    assert "read only by splid, gcsl, pchid:" in out and "read only by her:" in out
 
 
 @pytest.mark.slow
@@ -206,7 +218,9 @@ def test_corrupt_and_mismatched_checkpoints_fail_clearly(tmp_path, capsys):
                 with open(path, "r+b") as fh:
                     fh.truncate(os.path.getsize(path) // 2)
     assert main(["--resume", str(run_dir), "--iterations", "10", "--quiet"]) == 3
-    assert "error" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1
+    assert f"error: checkpoint {run_dir / 'checkpoints' / '5'} is corrupt or unreadable (" in err
 
 
 def test_env_options_build_the_task_the_run_trains_on(tmp_path):
@@ -223,7 +237,7 @@ def test_env_options_build_the_task_the_run_trains_on(tmp_path):
 def test_resume_under_changed_task_defaults_fails_naming_the_option(tmp_path):
     # the same config both times; only the task itself differs, as after a change of its defaults
     import envs
-    from splid_jax.checkpoint import CheckpointError
+    from splid_jax.runtime.checkpoint import CheckpointError
 
     cfg = TrainConfig(env="point", num_envs=4, eval_episodes=4, bc_steps=2, batch_size=16, hidden=(8,),
                       eval_every=5, iterations=5, run_dir=str(tmp_path / "run"))  # fmt: skip

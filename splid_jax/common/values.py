@@ -1,0 +1,100 @@
+"""Settings given as text (``KEY=VALUE[,KEY=VALUE...]``, as ``--env-options`` and ``figures --set``
+take them) read into values, and checked against a dataclass field's declared type."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+from splid_jax.common.errors import InvalidConfig, check
+
+
+def parse_overrides(text: str, field: str = "env_options") -> dict:
+    """``"finger=capsule,substeps=20"`` -> ``{"finger": "capsule", "substeps": 20}``: integers, floats
+    and words; an empty text is no override. A malformed item fails naming ``field``."""
+    overrides = {}
+    for part in filter(None, (p.strip() for p in text.split(","))):
+        key, sep, value = (x.strip() for x in part.partition("="))
+        if not sep or not key or not value:
+            raise InvalidConfig(field, text, "KEY=VALUE[,KEY=VALUE...] with task fields as keys")
+        overrides[key] = read_value(value)
+    return overrides
+
+
+def read_value(text: str) -> int | float | str:
+    """A setting's text as an integer, else a float, else the word itself."""
+    try:
+        return int(text)
+    except ValueError:
+        try:
+            return float(text)
+        except ValueError:
+            return text
+
+
+def typed_value(where: str, kind: str, value):
+    """A setting (as ``read_value`` reads it) as its field's declared type ``kind``, or one error naming
+    ``where``: ``20.5`` is no integer, ``big`` no number. A tuple of integers arrives with colons
+    between its widths (``64:64``), since commas separate the settings."""
+    if kind == "bool":
+        words = {"true": True, "1": True, "false": False, "0": False}
+        if str(value).lower() not in words:
+            raise InvalidConfig(where, value, "true or false")
+        return words[str(value).lower()]
+    if kind.startswith("tuple"):
+        try:
+            return tuple(int(w) for w in str(value).split(":"))
+        except ValueError:
+            raise InvalidConfig(where, str(value).replace(":", ","), "comma-separated integers, e.g. 64,64") from None
+    if kind == "int":
+        if isinstance(value, int) and not isinstance(value, bool):
+            return value
+        raise InvalidConfig(where, value, "an integer")
+    if kind == "float":
+        if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
+            return float(value)
+        raise InvalidConfig(where, value, "a finite number")
+    if kind == "str":
+        return str(value)
+    return value
+
+
+def parse_options(cls, text: str, field: str, prefix: str):
+    """A learner's config dataclass (``HerConfig``, ``EsConfig``) from ``KEY=VALUE[,KEY=VALUE...]``, read
+    by ``parse_overrides``; a tuple field takes its widths comma-separated too (``hidden=64,64``).
+    A bad key or value fails naming ``prefix.KEY``."""
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    items: list[str] = []
+    for part in (p.strip() for p in text.split(",")):
+        previous = items[-1].partition("=")[0].strip() if items else ""
+        if part and "=" not in part and previous in fields and str(fields[previous].type).startswith("tuple"):
+            items[-1] += ":" + part  # a further width of the tuple before
+        else:
+            items.append(part)
+    try:
+        overrides = parse_overrides(",".join(items), field)
+    except InvalidConfig:
+        raise InvalidConfig(field, text, f"KEY=VALUE[,KEY=VALUE...] with {prefix} fields as keys") from None
+    return cls(**typed_fields(cls, overrides, prefix))
+
+
+def typed_fields(cls, values: dict[str, Any], prefix: str) -> dict[str, Any]:
+    """``values`` (as ``parse_overrides`` reads them) as the declared types of ``cls``'s fields; an
+    unknown key or a value of another type fails naming ``prefix.KEY``."""
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    typed = {}
+    for key, value in values.items():
+        where = f"{prefix}.{key}"
+        check(key in fields, where, value, "one of the fields " + ", ".join(fields))
+        typed[key] = typed_value(where, str(fields[key].type), value)
+    return typed
+
+
+def option_fields(cls) -> str:
+    """``field=default (help); ...`` of a learner's config dataclass, for ``--help``."""
+    shown = []
+    for f in dataclasses.fields(cls):
+        default = ",".join(map(str, f.default)) if isinstance(f.default, tuple) else f.default
+        shown.append(f"{f.name}={default} ({f.metadata.get('help', '')})")
+    return "; ".join(shown)

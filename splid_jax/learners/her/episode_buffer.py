@@ -1,0 +1,82 @@
+"""HER's replay: whole episodes in a FIFO ring, and Baselines' future strategy that samples
+transitions from them with relabelled goals."""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+from flax import struct
+
+from splid_jax.common import ring_buffer
+
+
+@struct.dataclass
+class EpisodeBuffer:
+    """Whole episodes in a FIFO ring, so a transition's future achieved goals stay reachable."""
+
+    obs: jax.Array  # [E, T + 1, O]
+    achieved: jax.Array  # [E, T + 1, G]
+    goal: jax.Array  # [E, G]
+    actions: jax.Array  # [E, T, A] executed actions
+    ptr: jax.Array  # [] int32, next episode slot to write
+    size: jax.Array  # [] int32, filled slots
+
+    @property
+    def capacity(self) -> int:
+        return self.obs.shape[0]
+
+
+def buffer_init(episodes: int, T: int, obs_size: int, goal_size: int, action_size: int) -> EpisodeBuffer:
+    return EpisodeBuffer(
+        obs=jnp.zeros((episodes, T + 1, obs_size), jnp.float32),
+        achieved=jnp.zeros((episodes, T + 1, goal_size), jnp.float32),
+        goal=jnp.zeros((episodes, goal_size), jnp.float32),
+        actions=jnp.zeros((episodes, T, action_size), jnp.float32),
+        ptr=jnp.int32(0),
+        size=jnp.int32(0),
+    )
+
+
+def buffer_insert(buf: EpisodeBuffer, new: EpisodeBuffer, mask: jax.Array) -> EpisodeBuffer:
+    """Append the episodes of ``new`` where ``mask`` holds, in order, overwriting the oldest past
+    capacity (of a batch larger than the capacity only the newest ``capacity`` are kept)."""
+    rows = {"obs": new.obs, "achieved": new.achieved, "goal": new.goal, "actions": new.actions}
+    return ring_buffer.insert(buf, rows, mask)
+
+
+class Transitions(NamedTuple):
+    obs: jax.Array  # [B, O]
+    goal: jax.Array  # [B, G] the original goal, or with probability future_p a later achieved goal
+    action: jax.Array  # [B, A]
+    next_obs: jax.Array  # [B, O]
+    reward: jax.Array  # [B] the task's reward of the next achieved goal for that goal
+    episode: jax.Array  # [B] int32, the slot sampled
+    t: jax.Array  # [B] int32, the step sampled
+    future: jax.Array  # [B] int32 in [t + 1, T], where a relabelled goal was achieved
+    relabelled: jax.Array  # [B] bool
+
+
+def sample_transitions(buf: EpisodeBuffer, key: jax.Array, batch_size: int, future_p: float, reward_of) -> Transitions:
+    """Baselines' future strategy: a uniform episode and step; with probability ``future_p`` the goal
+    becomes the achieved goal of a uniform later step of the same episode; the reward is recomputed.
+    An empty buffer yields slot 0 (callers weight the loss by ``size > 0``)."""
+    T = buf.actions.shape[1]
+    k_ep, k_t, k_future, k_relabel = jax.random.split(key, 4)
+    ep = jax.random.randint(k_ep, (batch_size,), 0, jnp.maximum(buf.size, 1))
+    t = jax.random.randint(k_t, (batch_size,), 0, T)
+    future = jax.random.randint(k_future, (batch_size,), t + 1, T + 1)
+    relabelled = jax.random.uniform(k_relabel, (batch_size,)) < future_p
+    goal = jnp.where(relabelled[:, None], buf.achieved[ep, future], buf.goal[ep])
+    return Transitions(
+        obs=buf.obs[ep, t],
+        goal=goal,
+        action=buf.actions[ep, t],
+        next_obs=buf.obs[ep, t + 1],
+        reward=reward_of(buf.achieved[ep, t + 1], goal),
+        episode=ep,
+        t=t,
+        future=future,
+        relabelled=relabelled,
+    )

@@ -1,0 +1,52 @@
+"""The settings of the behaviour-cloning learners (SPLID, GCSL, PCHID), validated on construction.
+
+A run's ``TrainConfig`` records them flat beside the run's own settings (its config.json and command
+line keep one level); the registry builds this dataclass from it, so a learner reads only its own."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from splid_jax.common.errors import check
+
+RELABELS = ("paper", "hold", "settle")
+GCSL_RELABELS = ("final", "future")
+
+
+@dataclasses.dataclass(frozen=True)
+class ImitationConfig:
+    sigma: float
+    sigma_end: float
+    sigma_anneal: int
+    horizon: int
+    select: bool
+    relabel: str
+    select_radius: float
+    gcsl_relabel: str
+    pchid_every: int
+    select_lanes: float
+    buffer_size: int
+    batch_size: int
+    bc_steps: int
+    learning_rate: float
+    policy_ema: float
+    hidden: tuple[int, ...]
+    normalise: bool
+    relative_goal: bool
+
+    def __post_init__(self):
+        check(self.relabel in RELABELS, "relabel", self.relabel, "one of " + ", ".join(RELABELS))
+        check(self.gcsl_relabel in GCSL_RELABELS, "gcsl_relabel", self.gcsl_relabel, "final or future")
+        check(0 < self.select_radius <= 1, "select_radius", self.select_radius, "in (0, 1]")
+        check(self.pchid_every >= 0, "pchid_every", self.pchid_every, "an integer >= 0")
+        check(self.sigma >= 0, "sigma", self.sigma, ">= 0")
+        check(0 <= self.sigma_end <= 1, "sigma_end", self.sigma_end, "in [0, 1] (a fraction of sigma)")
+        check(self.sigma_anneal >= 1, "sigma_anneal", self.sigma_anneal, "an integer >= 1")
+        check(self.horizon >= 1, "horizon", self.horizon, "an integer >= 1 (and < the episode length)")
+        check(0 < self.select_lanes <= 1, "select_lanes", self.select_lanes, "in (0, 1]")
+        check(self.buffer_size >= 1, "buffer_size", self.buffer_size, "an integer >= 1")
+        check(self.batch_size >= 1, "batch_size", self.batch_size, "an integer >= 1")
+        check(self.bc_steps >= 0, "bc_steps", self.bc_steps, "an integer >= 0")
+        check(self.learning_rate > 0, "learning_rate", self.learning_rate, "> 0")
+        check(0 <= self.policy_ema < 1, "policy_ema", self.policy_ema, "in [0, 1)")
+        check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "hidden", self.hidden, "one or more widths >= 1")

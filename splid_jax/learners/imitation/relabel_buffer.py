@@ -1,0 +1,54 @@
+"""A functional FIFO ring buffer of (observation, relabelled goal, action) triples.
+
+Insertion takes a fixed-size batch plus a mask, so the shapes stay static under jit however many
+pairs SELECT accepted."""
+
+from __future__ import annotations
+
+import chex
+import jax
+import jax.numpy as jnp
+from flax import struct
+
+from splid_jax.common import ring_buffer
+
+
+@struct.dataclass
+class Buffer:
+    obs: jax.Array  # [C, O]
+    goal: jax.Array  # [C, G]
+    action: jax.Array  # [C, A]
+    ptr: jax.Array  # [] int32, next slot to write
+    size: jax.Array  # [] int32, filled slots
+
+    @property
+    def capacity(self) -> int:
+        return self.obs.shape[0]
+
+
+def init(capacity: int, obs_size: int, goal_size: int, action_size: int) -> Buffer:
+    return Buffer(
+        obs=jnp.zeros((capacity, obs_size), jnp.float32),
+        goal=jnp.zeros((capacity, goal_size), jnp.float32),
+        action=jnp.zeros((capacity, action_size), jnp.float32),
+        ptr=jnp.int32(0),
+        size=jnp.int32(0),
+    )
+
+
+def insert(buf: Buffer, obs: jax.Array, goal: jax.Array, action: jax.Array, mask: jax.Array) -> Buffer:
+    """Append the rows where ``mask`` holds, in order; past capacity the oldest are overwritten.
+    If one batch holds more than the capacity, only its newest ``capacity`` rows are kept."""
+    chex.assert_rank([obs, goal, action, mask], [2, 2, 2, 1])  # at trace time: a wrong layout fails here
+    chex.assert_equal_shape_prefix([obs, goal, action, mask], 1)
+    chex.assert_equal_shape_suffix([obs, buf.obs], 1)
+    chex.assert_equal_shape_suffix([goal, buf.goal], 1)
+    chex.assert_equal_shape_suffix([action, buf.action], 1)
+    return ring_buffer.insert(buf, {"obs": obs, "goal": goal, "action": action}, mask)
+
+
+def sample(buf: Buffer, key: jax.Array, batch_size: int) -> tuple[jax.Array, jax.Array, jax.Array]:
+    """Uniform over filled slots (with replacement). An empty buffer yields row 0 of zeros:
+    callers weight the loss by ``size > 0``."""
+    idx = jax.random.randint(key, (batch_size,), 0, jnp.maximum(buf.size, 1))
+    return buf.obs[idx], buf.goal[idx], buf.action[idx]

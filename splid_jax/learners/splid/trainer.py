@@ -1,0 +1,216 @@
+"""Algorithm 2 as one pure, scanned program: ``explore -> select -> insert -> bc`` per
+iteration, ``eval_every`` iterations and one evaluation per compiled chunk."""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import optax
+from flax import struct
+from jax.sharding import Mesh
+from jax.sharding import PartitionSpec as P
+
+from envs.base import GoalEnv
+from splid_jax.common.errors import check
+from splid_jax.common.networks import PolicyState, make_policy
+from splid_jax.config import TrainConfig
+from splid_jax.learners import gcsl, registry
+from splid_jax.learners.base import Chunked
+from splid_jax.learners.imitation import relabel_buffer
+from splid_jax.learners.imitation.bc import bc_epoch
+from splid_jax.learners.imitation.candidates import Candidates
+from splid_jax.learners.imitation.config import ImitationConfig
+from splid_jax.learners.imitation.explore import Seen, draws, rollout
+from splid_jax.learners.splid.select import select
+from splid_jax.runtime.devices import ENVS
+
+
+@struct.dataclass
+class TrainState:
+    policy: PolicyState  # the acting policy (explore, SELECT, eval, checkpoints' rollouts)
+    opt_state: optax.OptState
+    online: dict | None  # the cloned parameters when they differ from the acting ones (policy_ema > 0)
+    buffer: relabel_buffer.Buffer
+    key: jax.Array
+    iteration: jax.Array  # [] int32, completed iterations
+
+
+@struct.dataclass
+class Hyper:
+    """Hyper-parameters that may differ between members of one vmapped sweep."""
+
+    sigma: jax.Array  # [] float32
+    horizon: jax.Array  # [] int32, <= the trainer's max_horizon
+
+
+class Trainer(Chunked):
+    """The behaviour-cloning learners as ``learners.base.Algorithm``s: SPLID, PCHID (SPLID whose
+    horizon grows from 1 to H) and GCSL (every relabelled pair cloned), as the registry describes
+    each (``grows_horizon``, ``clones_every_pair``). Holds what is
+    static (task, network, optimiser, shapes); all state flows through arguments.
+
+    With a ``mesh`` (one axis, ``devices.ENVS``) each device explores and SELECTs its slice of the
+    envs; the pairs come back in the one-device layout, and insertion, BC and the parameters are
+    replicated, so the run computes what one device would, up to float rounding."""
+
+    def __init__(self, env: GoalEnv, cfg: TrainConfig, mesh: Mesh | None = None):
+        bc = cfg.learner_config()
+        check(isinstance(bc, ImitationConfig), "algo", cfg.algo, "a behaviour-cloning learner (splid, gcsl, pchid)")
+        cfg.check_env(env)
+        self.env, self.cfg, self.bc, self.name = env, cfg, bc, cfg.algo
+        self.learner = registry.get(cfg.algo)
+        self.max_horizon = bc.horizon  # shapes; a sweep's members mask larger h through Hyper.horizon
+        self.pchid_every = max(1, bc.pchid_every)  # TrainConfig resolves 0 for pchid
+        self.policy = make_policy(
+            env.obs_size,
+            env.goal_size,
+            env.action_size,
+            bc.hidden,
+            bc.normalise,
+            achieved_start=env.achieved_goal_start if bc.relative_goal else None,
+            goal_unit=env.success_distance,
+        )
+        self.optimiser = optax.adam(bc.learning_rate)
+        if mesh is not None:
+            check(cfg.num_envs % mesh.size == 0, "num_envs", cfg.num_envs, f"a multiple of the {mesh.size} devices")
+            # a model first built inside shard_map's trace would carry its manual axis into evaluation
+            getattr(env, "mjx_model", None)
+        self.mesh = mesh
+
+    def hyper(self, sigma: float | None = None, horizon: int | None = None) -> Hyper:
+        return Hyper(
+            sigma=jnp.float32(self.bc.sigma if sigma is None else sigma),
+            horizon=jnp.int32(self.bc.horizon if horizon is None else horizon),
+        )
+
+    def init(self, key: jax.Array) -> TrainState:
+        k_policy, k_run = jax.random.split(key)
+        pstate = self.policy.init(k_policy)
+        env, bc = self.env, self.bc
+        return TrainState(
+            policy=pstate,
+            opt_state=self.optimiser.init(pstate.params),
+            online=None if bc.policy_ema == 0 else jax.tree_util.tree_map(jnp.copy, pstate.params),
+            buffer=relabel_buffer.init(bc.buffer_size, env.obs_size, env.goal_size, env.action_size),
+            key=k_run,
+            iteration=jnp.int32(0),
+        )
+
+    def iteration(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
+        """One iteration; with a mesh, every device runs this same program on the whole state and
+        only exploration and SELECT are split (``explore_and_select``), so the run computes bit for
+        bit what one device computes."""
+        if self.mesh is None:
+            return self._iteration(ts, hyper)
+        whole = P()
+        return jax.shard_map(
+            self._iteration, mesh=self.mesh, in_specs=(whole, whole), out_specs=(whole, whole), check_vma=False
+        )(ts, hyper)
+
+    def _iteration(self, ts: TrainState, hyper: Hyper) -> tuple[TrainState, dict]:
+        env, cfg, bc, policy = self.env, self.cfg, self.bc, self.policy
+        key, k_explore, k_bc, k_relabel = jax.random.split(ts.key, 4)
+        reset_keys, noise = draws(env, k_explore, cfg.num_envs)
+        horizon = self.horizon_at(ts.iteration, hyper)
+        sigma = self.sigma_at(ts.iteration, hyper)
+        seen, cands = self.explore_and_select(ts.policy, reset_keys, noise, sigma, horizon)
+        if self.learner.clones_every_pair:
+            cands = gcsl.relabel(env, seen, bc.gcsl_relabel, k_relabel)
+        buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
+        pstate = policy.update_normaliser(ts.policy, seen.obs, seen.achieved[:-1], ~seen.invalid[:-1])
+        pstate, opt_state, online, loss = bc_epoch(
+            policy,
+            self.optimiser,
+            pstate,
+            ts.opt_state,
+            buf,
+            k_bc,
+            bc.bc_steps,
+            bc.batch_size,
+            online=ts.online,
+            ema=bc.policy_ema,
+        )
+        metrics = {
+            "select_pairs": jnp.sum(cands.valid, dtype=jnp.int32),
+            "select_held": jnp.sum(cands.valid & cands.held, dtype=jnp.int32),
+            "select_held_accepted": jnp.sum(cands.accept & cands.held, dtype=jnp.int32),
+            "select_accepted": jnp.sum(cands.accept, dtype=jnp.int32),
+            "select_steps": cands.replay_steps,
+            "bc_loss": loss,
+            "explore_success": jnp.mean(jnp.any(seen.success, axis=0)),
+        }
+        new = TrainState(
+            policy=pstate, opt_state=opt_state, online=online, buffer=buf, key=key, iteration=ts.iteration + 1
+        )
+        return new, metrics
+
+    def explore_and_select(self, pstate, reset_keys, noise, sigma, horizon) -> tuple[Seen, Candidates | None]:
+        """Explore the envs and, but for GCSL, SELECT among their relabelled pairs: all of them, or,
+        inside the mesh's ``shard_map``, this device's slice, gathered back in the one-device layout."""
+        if self.mesh is None:
+            return self._explore_and_select(pstate, reset_keys, noise, sigma, horizon)
+        n = self.cfg.num_envs // self.mesh.size
+        first = jax.lax.axis_index(ENVS) * n
+        seen, cands = self._explore_and_select(
+            pstate,
+            jax.lax.dynamic_slice_in_dim(reset_keys, first, n, axis=0),
+            jax.lax.dynamic_slice_in_dim(noise, first, n, axis=1),
+            sigma,
+            horizon,
+        )
+        gather = lambda x: jax.lax.all_gather(x, ENVS, axis=1, tiled=True)  # noqa: E731  [T, n] -> [T, N]
+        seen = jax.tree.map(gather, seen)
+        if cands is None:
+            return seen, None
+        # [H*T*n] in layout [H, T, n] -> [H*T, N] -> the one-device layout [H, T, N]
+        whole = [gather(x.reshape((-1, n) + x.shape[1:])).reshape((-1,) + x.shape[1:]) for x in cands[:-1]]
+        return seen, Candidates(*whole, jax.lax.psum(cands.replay_steps, ENVS))
+
+    def _explore_and_select(self, pstate, reset_keys, noise, sigma, horizon) -> tuple[Seen, Candidates | None]:
+        env, bc = self.env, self.bc
+        traj = rollout(env, self.policy, pstate, reset_keys, noise, sigma)
+        if self.learner.clones_every_pair:
+            return traj.seen(), None
+        cands = select(
+            env,
+            self.policy,
+            pstate,
+            traj,
+            self.max_horizon,
+            horizon,
+            bc.select,
+            bc.select_lanes,
+            hold=bc.relabel in ("hold", "settle"),
+            settle=bc.relabel == "settle",
+            radius=bc.select_radius,
+        )
+        return traj.seen(), cands
+
+    def sigma_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
+        """This iteration's exploration noise: sigma, falling linearly to sigma_end x sigma over the
+        first sigma_anneal iterations."""
+        fraction = optax.linear_schedule(1.0, self.bc.sigma_end, max(1, self.bc.sigma_anneal - 1))
+        return hyper.sigma * fraction(iteration)
+
+    def horizon_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
+        """The learning horizon of this iteration: H, or PCHID's curriculum 1, 2, ..., H."""
+        if not self.learner.grows_horizon:
+            return hyper.horizon
+        return jnp.minimum(hyper.horizon, 1 + iteration // self.pchid_every).astype(jnp.int32)
+
+    def chunk_metrics(self, ts: TrainState, hyper: Hyper, per_iter: dict) -> dict:
+        return dict(
+            select_pairs=jnp.sum(per_iter["select_pairs"]),
+            select_accepted=jnp.sum(per_iter["select_accepted"]),
+            select_held=jnp.sum(per_iter["select_held"]),
+            select_held_accepted=jnp.sum(per_iter["select_held_accepted"]),
+            horizon=self.horizon_at(ts.iteration - 1, hyper),
+            sigma=self.sigma_at(ts.iteration - 1, hyper),
+            select_steps=per_iter["select_steps"],  # [eval_every]: summed on the host, where ints do not overflow
+            bc_loss=per_iter["bc_loss"][-1],
+            explore_success=jnp.mean(per_iter["explore_success"]),
+            buffer_size=ts.buffer.size,
+        )
+
+    def watched(self, ts: TrainState, per_iter: dict) -> tuple:
+        return (ts.policy.params, ts.online), jnp.isfinite(per_iter["bc_loss"])

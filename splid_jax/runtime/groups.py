@@ -1,0 +1,63 @@
+"""A sweep's members split over several devices as equal groups, one single-device program each."""
+
+from __future__ import annotations
+
+import jax
+import numpy as np
+
+from splid_jax.runtime import checkpoint, devices, multihost
+from splid_jax.runtime.signals import Signals
+
+
+class Groups:
+    """A sweep's members in equal groups, one per device, each group a single-device program (the
+    vmapped chunk as one device runs it). Dispatch is asynchronous, so the devices run at once; a
+    group computes exactly what a sweep of its members computes on one device, and no collective
+    or SPMD partitioning is involved (XLA:GPU failed to compile MJX chunks partitioned by
+    ``shard_map``, and XLA:CPU can hang in multi-device programs). Over several
+    processes each runs the groups of its own devices, and the members' metrics and checkpointed
+    state are gathered between chunks (``multihost.concat``)."""
+
+    def __init__(self, place: devices.Placement, members: int):
+        every = list(place.mesh.devices.flat)
+        self.size = members // len(every)
+        self.devices = {i: d for i, d in enumerate(every) if d.process_index == jax.process_index()}  # group: device
+
+    def first(self, tree):
+        return jax.tree.map(lambda x: _slice(x, 0, self.size), tree)
+
+    def on(self, tree, device):
+        sharding = jax.sharding.SingleDeviceSharding(device)
+        return jax.tree.map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=sharding), tree)
+
+    def split(self, tree) -> tuple:
+        """This process's groups of the whole sweep's ``tree``."""
+        host = jax.device_get(tree)
+        return tuple(
+            jax.device_put(jax.tree.map(lambda x, i=i: _slice(x, i * self.size, self.size), host), device)
+            for i, device in self.devices.items()
+        )
+
+    def join(self, groups: tuple):
+        """The whole sweep's state to checkpoint, on the host of every process, from this process's groups."""
+        return checkpoint.on_host(multihost.concat(_concat(jax.device_get(groups))))
+
+    def compile(self, first, compile_on, signals: Signals):
+        rest = [signals.wait(lambda d=d: compile_on(d)) for d in list(self.devices.values())[1:]]
+        programs = [first, *rest]
+
+        def run(states: tuple, hypers: tuple):
+            outs = [p(s, h) for p, s, h in zip(programs, states, hypers, strict=True)]  # dispatched at once
+            return tuple(o[0] for o in outs), multihost.concat(_concat([o[1] for o in outs]))
+
+        return run
+
+
+def _concat(groups):
+    return jax.tree.map(lambda *xs: np.concatenate([np.asarray(x) for x in xs]), *groups)
+
+
+def _slice(x, start: int, size: int):
+    if isinstance(x, jax.ShapeDtypeStruct):
+        return jax.ShapeDtypeStruct((size,) + x.shape[1:], x.dtype, sharding=x.sharding)
+    return x[start : start + size]

@@ -1,0 +1,333 @@
+"""The one host loop: trains any ``learners.base.Algorithm``, one run or a vmapped set of sweep members.
+
+Python runs only between compiled chunks: it logs, writes metrics.jsonl (one schema for every
+algorithm, run and sweep), evaluates through the chunk, checkpoints with orbax, stops on NaN, and
+resumes bit for bit. The chunk is traced, checked against the device's memory and compiled once
+(``jax.jit(...).trace(...).lower().compile()``) before any state is allocated, so a run that cannot
+fit is refused with its estimate and the compile is timed apart from the first chunk.
+
+A signal stops the run at any moment with its newest whole state checkpointed (``signals``); the run
+directory's files are ``run_files``', the memory check ``memory``'s, a sweep split over devices
+``groups``'."""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import io
+import json
+import os
+import signal
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+import envs
+from splid_jax.common.errors import InvalidConfig
+from splid_jax.config import TrainConfig
+from splid_jax.learners import registry
+from splid_jax.learners.base import EVAL_KEYS, Algorithm
+from splid_jax.runtime import checkpoint, devices, multihost, progress
+from splid_jax.runtime.groups import Groups
+from splid_jax.runtime.memory import DoesNotFit, check_memory, compile_hint, gigabytes, largest_value, nbytes, sizes
+from splid_jax.runtime.run_files import (
+    METRICS,
+    SWEEP,
+    check_run_dir,
+    check_writable,
+    env_settings,
+    identity,
+    read_metrics,
+    write_atomic,
+    write_json,
+)
+from splid_jax.runtime.signals import Interrupted, Signals
+
+COUNTER_KEYS = ("iteration", "episodes", "env_steps", "select_steps")
+
+
+class RunStopped(RuntimeError):
+    """The run stopped early for a reason the user must see (NaN); exit code 3."""
+
+
+def make_env(name: str, **overrides) -> envs.GoalEnv:
+    with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
+        return envs.make(name, **overrides)
+
+
+def placement(cfg: TrainConfig, members: int | None, algo: Algorithm | None = None) -> devices.Placement:
+    """The devices a run (``members`` None) or a sweep of ``members`` uses (``cfg.num_devices``)."""
+    if members is not None:
+        return devices.place(cfg.num_devices, members, devices.MEMBERS)
+    if algo is not None:  # built by the caller: its own mesh, if any
+        mesh = getattr(algo, "mesh", None)
+        return devices.Placement(mesh, devices.ENVS) if mesh is not None else devices.place(1, 1, devices.ENVS)
+    if not registry.get(cfg.algo).splits_envs:
+        allowed = f"1 or 0 for a single {cfg.algo} run (a sweep of {cfg.algo} splits its members)"
+        if cfg.num_devices > 1:
+            raise InvalidConfig("num_devices", cfg.num_devices, allowed)
+        return devices.place(1, 1, devices.ENVS)
+    return devices.place(cfg.num_devices, cfg.num_envs, devices.ENVS)
+
+
+def _lane_hyper(algo: Algorithm, base: TrainConfig, lane: TrainConfig) -> Any:
+    """``algo.hyper()`` with each leaf named after a config field set to the member's value. A member
+    may differ from the sweep's config only in its seed, its run_dir and such fields."""
+    hyper = algo.hyper()
+    names = [f.name for f in dataclasses.fields(hyper)] if dataclasses.is_dataclass(hyper) else list(hyper)
+    for f in dataclasses.fields(TrainConfig):
+        if f.name not in ("seed", "run_dir", *names) and getattr(lane, f.name) != getattr(base, f.name):
+            allowed = f"{getattr(base, f.name)!r} in every member of a sweep of {algo.name} (not a traced setting)"
+            raise InvalidConfig(f.name, getattr(lane, f.name), allowed)
+    values = {n: jnp.asarray(getattr(lane, n), jnp.asarray(_get(hyper, n)).dtype) for n in names if hasattr(lane, n)}
+    return hyper.replace(**values) if dataclasses.is_dataclass(hyper) else {**hyper, **values}
+
+
+def _get(tree, name):
+    return tree[name] if isinstance(tree, dict) else getattr(tree, name)
+
+
+def _canonical(tree, sharding):
+    """Strongly typed arrays placed as ``sharding`` says, whether they come from init or a checkpoint,
+    so the compiled chunk takes a resumed state as it takes a fresh one."""
+    # made on one device, then placed: XLA:CPU can hang in a later program that reads an array a
+    # multi-device jit wrote through out_shardings
+    return jax.device_put(jax.jit(_strong)(tree), sharding)
+
+
+def _strong(tree):
+    return jax.tree.map(lambda x: jnp.asarray(x).astype(jnp.asarray(x).dtype), tree)
+
+
+def _abstract(tree, sharding):
+    return jax.tree.map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=sharding), tree)
+
+
+def _record(algo, cfg, metrics: dict, i: int | None, iteration: int, total: int, chunk: int, chunk_s, wall_s):
+    rec = algo.counters(iteration, total)
+    rec.update({k: metrics[k] if i is None else metrics[k][i] for k in EVAL_KEYS})
+    rec.update({k: v if i is None else v[i] for k, v in metrics.items() if k not in rec})
+    rec = {k: v.item() if hasattr(v, "item") else v for k, v in rec.items()}
+    steps = algo.counters(cfg.eval_every, chunk)
+    rec["steps_per_s"] = (steps["env_steps"] + steps["select_steps"]) / max(chunk_s, 1e-9)
+    rec["wall_s"] = wall_s
+    return rec
+
+
+def run(
+    cfg: TrainConfig,
+    env: envs.GoalEnv | None = None,
+    *,
+    algo: Algorithm | None = None,
+    members: Sequence[TrainConfig] | None = None,
+    resume: bool = False,
+    quiet: bool = False,
+) -> list[dict]:
+    """Train to ``cfg.iterations``; returns the last metrics record of each lane (one for a run).
+
+    ``members``: the configs of a sweep's members (each its own seed, run_dir and traced settings),
+    trained in lock-step as one vmapped program with checkpoints under ``cfg.run_dir``. Over several
+    processes every process calls it alike and each returns the records; only process 0 writes and shows."""
+    env = env or make_env(cfg.env, **cfg.env_overrides())
+    place = placement(cfg, None if members is None else len(members), algo)
+    split_envs = place.axis == devices.ENVS and place.count > 1
+    algo = algo or registry.make_algorithm(cfg, env, place.mesh if split_envs else None)
+    with Signals() as signals:
+        return _Loop(cfg, env, algo, members, place, signals, quiet).run(resume)
+
+
+class _Loop:
+    def __init__(self, cfg, env, algo, members, place: devices.Placement, signals: Signals, quiet: bool):
+        self.cfg, self.env, self.algo, self.signals = cfg, env, algo, signals
+        self.writes = multihost.is_first()  # the others compute their share and leave the run directory alone
+        self.quiet = quiet or not self.writes
+        self.stacked = members is not None
+        self.lanes = list(members) if self.stacked else [cfg]
+        self.place = place
+        self.device = place.first
+        self.saved_at: int | None = None
+        self.groups: Groups | None = None
+
+    def show(self, text: str) -> None:
+        progress.show(text, self.quiet)
+
+    def meta(self) -> dict:
+        meta = {"config": identity(self.cfg), "env": env_settings(self.env)}
+        if self.stacked:
+            meta["members"] = [identity(m) | {"run_dir": os.path.basename(m.run_dir)} for m in self.lanes]
+        return meta
+
+    def run(self, resume: bool) -> list[dict]:
+        cfg = self.cfg
+        step = multihost.from_first(lambda: check_run_dir(cfg, resume))
+        if resume and step == cfg.iterations:
+            self.show(f"{cfg.run_dir}: already complete ({step} iterations); nothing to do")
+            return multihost.from_first(
+                lambda: [(read_metrics(os.path.join(m.run_dir, METRICS)) or [{}])[-1] for m in self.lanes]
+            )
+        multihost.from_first(lambda: check_writable(cfg.run_dir))
+        self.saved_at = step
+        try:
+            return self.start(resume, step)
+        except Interrupted as stop:
+            if not getattr(stop, "reported", False):
+                kept = "nothing saved" if step is None else f"the checkpoint at iteration {step} is kept"
+                self.show(f"interrupted ({signal.Signals(stop.signum).name}) before the first chunk ended: {kept}")
+            raise
+
+    def start(self, resume: bool, step: int | None) -> list[dict]:
+        cfg, algo = self.cfg, self.algo
+
+        keys = [jax.random.PRNGKey(m.seed) for m in self.lanes]
+        hypers = [_lane_hyper(algo, cfg, m) for m in self.lanes]
+        init, chunk = algo.init, algo.chunk
+        place = self.place
+        if self.stacked:
+            keys, hyper = jnp.stack(keys), jax.tree.map(lambda *x: jnp.stack(x), *hypers)
+            init, chunk = jax.vmap(init), jax.vmap(chunk)
+        else:
+            keys, hyper = keys[0], hypers[0]
+        split = self.stacked and place.axis == devices.MEMBERS and place.count > 1
+        groups = Groups(place, len(self.lanes)) if split else None
+        sharding = place.state_sharding() if groups is None else jax.sharding.SingleDeviceSharding(self.device)
+        like = _abstract(jax.eval_shape(init, keys), sharding)  # the whole sweep's, as checkpoints hold it
+        one = like if groups is None else groups.first(like)  # what one compiled program takes
+        hyper = _canonical(hyper, sharding)
+        try:
+            traced = self.signals.wait(lambda: jax.jit(chunk).trace(one, groups.first(hyper) if groups else hyper))
+        except OverflowError as e:  # an index past int32: sizes far beyond any device's memory
+            raise DoesNotFit(
+                f"invalid sizes ({sizes(cfg, len(self.lanes))}): too large for the program's 32-bit indices, "
+                "and for any device's memory"
+            ) from e
+        state_bytes = sum(nbytes(x) for x in jax.tree.leaves(one))
+        largest = largest_value(traced.jaxpr.jaxpr)
+        what = f"state {gigabytes(state_bytes)} twice, largest intermediate {gigabytes(largest)}"
+        check_memory(2 * state_bytes + largest, what, self.device, cfg, len(self.lanes))
+
+        processes = f" of {jax.process_count()} processes" if jax.process_count() > 1 else ""
+        on = f"{place.count} devices{processes} split by {place.axis}" if place.count > 1 else self.device.platform
+        self.show(f"splid_jax: algo={algo.name} env={cfg.env} device={on}"
+                  + (f" members={len(self.lanes)}" if self.stacked else ""))  # fmt: skip
+        self.show(f"compiling the training program ({compile_hint(self.env)}; "
+                  "less when the compile cache holds it)...")  # fmt: skip
+        t0 = time.perf_counter()
+        compiled = self.signals.wait(lambda: traced.lower().compile())
+        analysis = compiled.memory_analysis()
+        if groups is not None:
+            compiled = groups.compile(compiled, lambda dev: jax.jit(chunk).trace(
+                groups.on(one, dev), groups.on(groups.first(hyper), dev)).lower().compile(), self.signals)  # fmt: skip
+            hyper = groups.split(hyper)
+        self.show(f"compiled in {time.perf_counter() - t0:.1f} s")
+        if analysis is not None:
+            need = analysis.argument_size_in_bytes + analysis.output_size_in_bytes + analysis.temp_size_in_bytes
+            check_memory(need - analysis.alias_size_in_bytes, "as compiled", self.device, cfg, len(self.lanes))
+
+        if resume:
+            state, select_steps, wall_before = self.restore(like)
+        else:
+            state = _canonical(self.signals.wait(lambda: jax.jit(init)(keys)), sharding)
+            state = state if groups is None else groups.split(state)
+            select_steps, wall_before = [0] * len(self.lanes), 0.0
+            for lane in self.lanes if self.writes else ():
+                os.makedirs(lane.run_dir, exist_ok=True)
+                write_atomic(os.path.join(lane.run_dir, METRICS), "")
+        for lane in self.lanes if self.writes else ():
+            write_json(os.path.join(lane.run_dir, "config.json"), {**lane.to_json(), "devices": place.record()})
+        if self.stacked and self.writes:
+            named = [{**m.to_json(), "run_dir": os.path.basename(m.run_dir)} for m in self.lanes]
+            write_json(os.path.join(cfg.run_dir, SWEEP), {"config": cfg.to_json(), "members": named})
+        self.groups = groups
+        return self.train(compiled, state, hyper, step or 0, select_steps, wall_before)
+
+    def restore(self, like):
+        cfg = self.cfg
+
+        def read():
+            step, state, meta = checkpoint.restore(cfg.run_dir, like, expect_meta=self.meta())
+            for lane in self.lanes:  # lines written past the checkpoint are dropped, as is a torn last line
+                path = os.path.join(lane.run_dir, METRICS)
+                kept = [r for r in read_metrics(path) if r["iteration"] <= step]
+                write_atomic(path, "".join(json.dumps(r) + "\n" for r in kept))
+            return step, state, meta
+
+        step, state, meta = self.signals.wait(lambda: multihost.from_first(read))
+        self.show(f"resumed {cfg.run_dir} at iteration {step}")
+        if self.stacked and self.place.axis == devices.MEMBERS and self.place.count > 1:
+            state = Groups(self.place, len(self.lanes)).split(state)
+        else:
+            state = _canonical(state, self.place.state_sharding())
+        return state, [int(s) for s in meta["select_steps"]], float(meta["wall_s"])
+
+    def save(self, state, iteration: int, select_steps: list[int], wall_s: float) -> None:
+        if self.saved_at == iteration:
+            return
+        meta = {**self.meta(), "wall_s": wall_s, "select_steps": select_steps}
+        whole = state if self.groups is None else self.groups.join(state)
+        if self.writes:
+            checkpoint.save(self.cfg.run_dir, iteration, whole, meta)
+        multihost.barrier("checkpoint saved")  # before a stop lets any process exit
+        self.saved_at = iteration
+
+    def train(self, compiled, state, hyper, iteration: int, select_steps: list[int], wall_before: float):
+        cfg, algo, lanes = self.cfg, self.algo, self.lanes
+        start = time.perf_counter()
+
+        def wall() -> float:
+            return wall_before + time.perf_counter() - start
+
+        if self.stacked:
+            self.show(f"sweep: {len(lanes)} members in one program, {cfg.iterations} iterations")
+        last, chunks = [{}] * len(lanes), 0
+        try:
+            while iteration < cfg.iterations:
+                t0 = time.perf_counter()
+                new_state, metrics = self.signals.wait(lambda s=state: jax.block_until_ready(compiled(s, hyper)))
+                chunk_s = time.perf_counter() - t0
+                metrics = jax.device_get(metrics)
+                finite = np.asarray(metrics.pop("finite")).reshape(-1)
+                done = iteration + cfg.eval_every
+                if not finite.all():
+                    bad = ", ".join(os.path.basename(lanes[i].run_dir) for i in np.flatnonzero(~finite))
+                    raise RunStopped(
+                        f"non-finite loss or parameters after iteration {done}"
+                        + (f" in {bad}" if self.stacked else "")
+                        + f"; stopped, the last good state (iteration {iteration}) is kept in {cfg.run_dir}"
+                    )
+                none = np.zeros((len(lanes), cfg.eval_every))  # learners that replay nothing report no steps
+                per_lane = np.asarray(metrics.pop("select_steps", none), np.int64)
+                per_lane = per_lane.reshape(len(lanes), -1).sum(axis=-1)
+                totals = [t + int(c) for t, c in zip(select_steps, per_lane, strict=True)]
+                now = wall()
+                last = [
+                    _record(
+                        algo, cfg, metrics, i if self.stacked else None, done, totals[i], int(per_lane[i]), chunk_s, now
+                    )  # fmt: skip
+                    for i in range(len(lanes))
+                ]
+                for lane, rec in zip(lanes, last, strict=True) if self.writes else ():  # past a checkpoint: dropped
+                    with open(os.path.join(lane.run_dir, METRICS), "a") as fh:
+                        fh.write(json.dumps(rec) + "\n")
+                state, iteration, select_steps, chunks = new_state, done, totals, chunks + 1
+                if self.stacked:
+                    self.show(progress.sweep_line(last, cfg.iterations))
+                else:
+                    self.show((progress.header(last[0]) + "\n" if chunks == 1 else "") + progress.line(last[0],
+                              cfg.iterations))  # fmt: skip
+                if iteration == cfg.iterations or (cfg.checkpoint_every and chunks % cfg.checkpoint_every == 0):
+                    self.save(state, iteration, select_steps, wall())
+                self.signals.agree()
+        except Interrupted as stop:
+            self.save(state, iteration, select_steps, wall())
+            name = signal.Signals(stop.signum).name
+            self.show(f"interrupted ({name}): saved iteration {iteration} to {cfg.run_dir}; resume with --resume")
+            stop.reported = True
+            raise
+        except RunStopped:
+            self.save(state, iteration, select_steps, wall())
+            raise
+        return last

@@ -1,0 +1,98 @@
+"""A run directory's files: config.json, metrics.jsonl (one line per chunk), a sweep's sweep.json, and
+the checks that keep one run from overwriting another."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+
+import envs
+from splid_jax.common.errors import InvalidConfig
+from splid_jax.config import TrainConfig
+from splid_jax.runtime import checkpoint, progress
+
+# Fields a resumed run must share with its checkpoint; the rest may change on resume.
+MAY_CHANGE_ON_RESUME = frozenset({"iterations", "run_dir", "checkpoint_every", "num_devices"})
+METRICS = "metrics.jsonl"
+SWEEP = "sweep.json"  # a sweep's config and its members' configs, from which it resumes
+
+
+def env_settings(env: envs.GoalEnv) -> dict:
+    """The task's every option as JSON stores it: a resume under other task defaults fails naming one."""
+    return json.loads(json.dumps(env.settings()))
+
+
+def identity(cfg: TrainConfig) -> dict:
+    """The settings a checkpoint must share with the run resuming it, as JSON stores them."""
+    return json.loads(json.dumps({k: v for k, v in cfg.to_json().items() if k not in MAY_CHANGE_ON_RESUME}))
+
+
+def read_metrics(path: str) -> list[dict]:
+    return progress.read_metrics(path, checkpoint.CheckpointError)
+
+
+def write_atomic(path: str, text: str) -> None:
+    tmp = path + ".tmp"
+    with open(tmp, "w") as fh:
+        fh.write(text)
+    os.replace(tmp, path)
+
+
+def write_json(path: str, obj) -> None:
+    """``obj`` as JSON at ``path``, replaced whole: a reader never sees half a file."""
+    write_atomic(path, json.dumps(obj, indent=2, allow_nan=False))
+
+
+def holds_metrics(run_dir: str) -> str | None:
+    """A sweep's record, or a metrics.jsonl with content in ``run_dir`` or one level below (a sweep's members)."""
+    if not os.path.isdir(run_dir):
+        return None
+    if os.path.isfile(os.path.join(run_dir, SWEEP)):
+        return os.path.join(run_dir, SWEEP)
+    candidates = [os.path.join(run_dir, METRICS)]
+    candidates += [os.path.join(run_dir, d, METRICS) for d in sorted(os.listdir(run_dir))]
+    for path in candidates:
+        if os.path.isfile(path) and os.path.getsize(path) > 0:
+            return path
+    return None
+
+
+def check_run_dir(cfg: TrainConfig, resume: bool) -> int | None:
+    """Refuses a run that would overwrite another, or a resume to fewer iterations than done;
+    returns the step a resume starts from."""
+    if not resume:
+        if os.path.isdir(cfg.run_dir) and checkpoint.latest_step(cfg.run_dir) is not None:
+            raise InvalidConfig("run_dir", cfg.run_dir, "a directory without a run in it (or pass --resume RUN_DIR)")
+        held = holds_metrics(cfg.run_dir)
+        if held is not None:
+            raise InvalidConfig("run_dir", cfg.run_dir, f"a directory without a run in it (it holds {held})")
+        return None
+    step = checkpoint.latest_step(cfg.run_dir) if os.path.isdir(cfg.run_dir) else None
+    if step is None:
+        raise InvalidConfig("resume", cfg.run_dir, "a run directory holding a checkpoint")
+    if step > cfg.iterations:
+        raise InvalidConfig("iterations", cfg.iterations, f">= {step}, the iterations {cfg.run_dir} has completed")
+    return step
+
+
+def check_writable(run_dir: str) -> None:
+    """Creates ``run_dir`` and a file in it, then removes what it made: a read-only filesystem or
+    /proc fails here, naming the directory, before any work."""
+    made, path = [], os.path.abspath(run_dir)
+    while not os.path.exists(path):
+        made.append(path)
+        path = os.path.dirname(path)
+    try:
+        for d in reversed(made):
+            os.mkdir(d)
+        probe = os.path.join(run_dir, f".write-test-{os.getpid()}")
+        with open(probe, "w") as fh:
+            fh.write("x")
+        os.remove(probe)
+    except OSError as e:
+        raise InvalidConfig("run_dir", run_dir, f"a writable directory ({e.strerror})") from None
+    finally:
+        for d in made:
+            with contextlib.suppress(OSError):
+                os.rmdir(d)

@@ -1,0 +1,84 @@
+"""SIGINT (Ctrl-C) and SIGTERM (what a preemptible cluster sends) stop a run alike at any moment,
+compilation included: the host loop checkpoints the newest state that is whole and raises
+``Interrupted``, which the command lines turn into exit code 130 (SIGINT) or 143 (SIGTERM)."""
+
+from __future__ import annotations
+
+import signal
+import threading
+from collections.abc import Callable
+from typing import Any
+
+import jax
+
+from splid_jax.runtime import multihost
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM stopped the run; ``exit_code`` is 128 + the signal's number."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+        self.exit_code = 128 + signum
+
+
+class Signals:
+    """SIGINT and SIGTERM only set a flag, read between steps. Blocking work (tracing, compiling, a
+    chunk) runs in a daemon thread while the main thread waits in short slices, so a signal is seen
+    within a fraction of a second instead of after a compilation of minutes.
+
+    Over several processes a signal is acted on only after a chunk, where every process learns of it
+    (``agree``): all then stop at the same iteration and take part in its checkpoint."""
+
+    def __init__(self):
+        self.signum: int | None = None
+        self.shared = jax.process_count() > 1
+        self._previous: dict[int, Any] = {}
+
+    def __enter__(self) -> Signals:
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                self._previous[sig] = signal.signal(sig, self._caught)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for sig, handler in self._previous.items():
+            signal.signal(sig, handler)
+
+    def _caught(self, signum, frame) -> None:
+        if self.signum is None:
+            self.signum = signum
+
+    def check(self) -> None:
+        if self.signum is not None and not self.shared:
+            raise Interrupted(self.signum)
+
+    def agree(self) -> None:
+        """``check``, after every process has told the others of the signal it got, if any."""
+        if self.shared:
+            self.signum = multihost.any_of(self.signum or 0) or None
+            if self.signum is not None:
+                raise Interrupted(self.signum)
+        self.check()
+
+    def wait(self, fn: Callable[[], Any]) -> Any:
+        """``fn()`` in a daemon thread; raises ``Interrupted`` as soon as a signal came (the thread is
+        left to finish or to die with the process)."""
+        self.check()
+        box: dict[str, Any] = {}
+
+        def work():
+            try:
+                box["out"] = fn()
+            except BaseException as e:  # handed to the main thread as is
+                box["err"] = e
+
+        thread = threading.Thread(target=work, name="splid_jax-work", daemon=True)
+        thread.start()
+        while thread.is_alive():
+            thread.join(0.05)
+            self.check()
+        if "err" in box:
+            raise box["err"]
+        return box["out"]

@@ -1,0 +1,50 @@
+"""Oracles the tests check the learners against: plain definitions of what the compiled programs
+compute fast, and small measures shared by several test files."""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+
+from envs.base import GoalEnv, State
+from splid_jax.common.networks import Policy, PolicyState
+from splid_jax.learners.imitation.explore import Trajectory, draws, rollout
+
+
+def explore(
+    env: GoalEnv, policy: Policy, pstate: PolicyState, key: jax.Array, num_envs: int, sigma: jax.Array
+) -> Trajectory:
+    """One episode in each of ``num_envs`` envs, resets and noise drawn from ``key`` as an iteration draws them."""
+    return rollout(env, policy, pstate, *draws(env, key, num_envs), sigma)
+
+
+def policy_reaches(
+    env: GoalEnv, policy: Policy, pstate: PolicyState, state: State, goal: jax.Array, h, at_final=False
+):
+    """Whether the deterministic policy, restored at ``state``, hits ``goal`` within ``h`` steps (or,
+    ``at_final``, is at it after exactly ``h`` steps): the definition SELECT's work queue must agree with."""
+
+    def one_step(_, carry):
+        s, hit = carry
+        s = env.step(s, policy.act(pstate, s.obs, s.desired_goal))
+        now = s.success & ~s.invalid
+        return s, jnp.where(at_final, now, hit | now)
+
+    _, hit = jax.lax.fori_loop(0, h, one_step, (env.with_goal(state, goal), jnp.bool_(False)))
+    return hit
+
+
+def random_policy_success(env: GoalEnv, episodes: int = 256) -> float:
+    """Success at any step of uniformly random actions on a 2-D action task: the floor a learner must beat."""
+
+    def episode(key):
+        k0, k1 = jax.random.split(key)
+        s = env.reset(k0)
+
+        def one(s, k):
+            s = env.step(s, jax.random.uniform(k, (2,), minval=-1, maxval=1))
+            return s, s.success
+
+        return jnp.any(jax.lax.scan(one, s, jax.random.split(k1, env.episode_length))[1])
+
+    return float(jnp.mean(jax.jit(jax.vmap(episode))(jax.random.split(jax.random.PRNGKey(7), episodes))))

@@ -1,0 +1,28 @@
+"""Evaluation judges the policy on the task's standard starts, whatever the training task explores."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import jax
+
+from envs.point_fourrooms import PointFourRooms
+from splid_jax.common.evaluation import evaluate
+from splid_jax.common.networks import make_policy
+
+
+@dataclasses.dataclass(frozen=True)
+class _TrainingOnlyStarts(PointFourRooms):
+    def evaluation_task(self):
+        return PointFourRooms()
+
+    def reset(self, key):
+        raise AssertionError("evaluation reset the training task")
+
+
+def test_evaluation_resets_the_standard_task():
+    env = _TrainingOnlyStarts()
+    policy = make_policy(env.obs_size, env.goal_size, env.action_size, (8,), normalise=False)
+    pstate = policy.init(jax.random.PRNGKey(0))
+    metrics = evaluate(env, policy, pstate, jax.random.PRNGKey(1), 4)
+    assert 0.0 <= float(metrics["eval_success"]) <= 1.0

@@ -1,0 +1,67 @@
+import chex
+import jax
+import jax.numpy as jnp
+import optax
+
+from splid_jax.common.networks import make_policy
+from splid_jax.learners.imitation import relabel_buffer
+from splid_jax.learners.imitation.bc import bc_epoch, bc_loss, bc_step
+
+
+def _setup():
+    policy = make_policy(2, 2, 2, (32, 32), normalise=False)
+    pstate = policy.init(jax.random.PRNGKey(0))
+    k1, k2 = jax.random.split(jax.random.PRNGKey(1))
+    obs, goal = jax.random.normal(k1, (64, 2)), jax.random.normal(k2, (64, 2))
+    action = jnp.clip(goal - obs, -1, 1)  # a learnable target
+    return policy, pstate, (obs, goal, action)
+
+
+def test_bc_steps_on_a_fixed_batch_lower_the_loss():
+    policy, pstate, batch = _setup()
+    opt = optax.adam(1e-2)
+    opt_state = opt.init(pstate.params)
+    before = bc_loss(pstate.params, policy, pstate, *batch)
+    step = jax.jit(lambda p, o: bc_step(policy, opt, p, o, batch, 1.0))
+    for _ in range(100):
+        pstate, opt_state, _, _ = step(pstate, opt_state)
+    after = bc_loss(pstate.params, policy, pstate, *batch)
+    assert float(after) < 0.2 * float(before)
+
+
+def test_polyak_acting_policy_follows_the_cloned_one_at_rate_one_minus_decay():
+    policy, pstate, batch = _setup()
+    opt = optax.adam(1e-2)
+    opt_state = opt.init(pstate.params)
+    online = jax.tree_util.tree_map(jnp.copy, pstate.params)
+    step = jax.jit(lambda p, o, on: bc_step(policy, opt, p, o, batch, 1.0, on, 0.9))
+    acting, _, cloned, _ = step(pstate, opt_state, online)
+    # one step: the acting parameters move a tenth of the way the cloned ones moved
+    moved = jax.tree_util.tree_map(lambda a, c, o: a - (o + 0.1 * (c - o)), acting.params, cloned, online)
+    assert max(float(jnp.max(jnp.abs(x))) for x in jax.tree_util.tree_leaves(moved)) < 1e-6
+    ps, os, on = pstate, opt_state, online
+    for _ in range(200):
+        ps, os, on, _ = step(ps, os, on)
+    before = float(bc_loss(pstate.params, policy, pstate, *batch))
+    assert float(bc_loss(on, policy, ps, *batch)) < 0.2 * before  # the cloned parameters learn
+    assert float(bc_loss(ps.params, policy, ps, *batch)) < 0.2 * before  # and the average acts as well
+
+
+def test_empty_buffer_leaves_parameters_unchanged():
+    policy, pstate, _ = _setup()
+    opt = optax.adam(1e-2)
+    buf = relabel_buffer.init(16, 2, 2, 2)
+    new, _, _, _ = bc_epoch(policy, opt, pstate, opt.init(pstate.params), buf, jax.random.PRNGKey(0), 5, 8)
+    chex.assert_trees_all_equal(new.params, pstate.params)
+
+
+def test_normaliser_ignores_rows_flagged_invalid():
+    policy = make_policy(2, 2, 2, (8,), normalise=True)
+    pstate = policy.init(jax.random.PRNGKey(0))
+    obs = jnp.array([[1.0, 2.0], [jnp.nan, jnp.nan], [3.0, 4.0]])
+    goal = jnp.zeros((3, 2))
+    new = policy.update_normaliser(pstate, obs, goal, jnp.array([True, False, True]))
+    clean = policy.update_normaliser(pstate, obs[jnp.array([0, 2])], goal[:2])
+    chex.assert_trees_all_close(new.normaliser.mean, clean.normaliser.mean)
+    chex.assert_trees_all_close(new.normaliser.std, clean.normaliser.std)
+    assert bool(jnp.all(jnp.isfinite(policy.act(new, obs[:1], goal[:1]))))

@@ -1,0 +1,48 @@
+import chex
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from splid_jax.learners.imitation import relabel_buffer
+
+
+def _rows(values):
+    v = jnp.asarray(values, jnp.float32)[:, None]
+    return v, v + 100, v + 200
+
+
+def test_masked_insert_keeps_only_masked_rows_in_order():
+    buf = relabel_buffer.init(8, 1, 1, 1)
+    obs, goal, act = _rows([1, 2, 3, 4, 5])
+    buf = relabel_buffer.insert(buf, obs, goal, act, jnp.array([1, 0, 1, 0, 1], bool))
+    assert int(buf.size) == 3 and int(buf.ptr) == 3
+    np.testing.assert_array_equal(buf.obs[:3, 0], [1, 3, 5])
+    np.testing.assert_array_equal(buf.goal[:3, 0], [101, 103, 105])
+    np.testing.assert_array_equal(buf.obs[3:, 0], 0)
+
+
+def test_wraps_around_overwriting_oldest():
+    buf = relabel_buffer.init(4, 1, 1, 1)
+    insert = jax.jit(relabel_buffer.insert)
+    buf = insert(buf, *_rows([1, 2, 3]), jnp.ones(3, bool))
+    buf = insert(buf, *_rows([4, 5, 6]), jnp.ones(3, bool))
+    assert int(buf.size) == 4 and int(buf.ptr) == 2
+    np.testing.assert_array_equal(buf.obs[:, 0], [5, 6, 3, 4])
+
+
+def test_batch_larger_than_capacity_keeps_newest():
+    buf = relabel_buffer.init(3, 1, 1, 1)
+    buf = relabel_buffer.insert(buf, *_rows([1, 2, 3, 4, 5, 6]), jnp.array([1, 1, 1, 1, 1, 0], bool))
+    assert int(buf.size) == 3
+    assert sorted(np.asarray(buf.obs[:, 0]).tolist()) == [3, 4, 5]
+
+
+def test_sampling_draws_only_filled_rows_uniformly():
+    buf = relabel_buffer.init(100, 1, 1, 1)
+    buf = relabel_buffer.insert(buf, *_rows([1, 2, 3, 4]), jnp.ones(4, bool))
+    obs, goal, act = relabel_buffer.sample(buf, jax.random.PRNGKey(0), 4000)
+    chex.assert_shape([obs, goal, act], (4000, 1))
+    values, counts = np.unique(np.asarray(obs[:, 0]), return_counts=True)
+    np.testing.assert_array_equal(values, [1, 2, 3, 4])
+    assert counts.min() > 850  # about 1000 each
+    np.testing.assert_array_equal(goal - obs, 100)  # rows stay aligned

@@ -1,0 +1,87 @@
+"""The scanned SPLID iteration on the point task: compiled once, deterministic, and it learns."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import envs
+from splid_jax.config import TrainConfig
+from splid_jax.learners.splid.trainer import Trainer
+from tests.helpers import random_policy_success
+
+pytestmark = pytest.mark.slow  # trains
+
+CFG = dict(env="point", num_envs=16, iterations=40, eval_every=10, bc_steps=50, batch_size=128, eval_episodes=256)
+
+
+@pytest.fixture(scope="module")
+def trainer():
+    trainer = Trainer(envs.make("point"), TrainConfig(**CFG))
+    trainer.traces = 0
+
+    def counted(state, hyper):  # counts Python traces: one per compilation
+        trainer.traces += 1
+        return trainer.chunk(state, hyper)
+
+    trainer.jitted = jax.jit(counted)
+    return trainer
+
+
+def run_chunks(trainer, seed, chunks):
+    state, out = trainer.init(jax.random.PRNGKey(seed)), []
+    for _ in range(chunks):
+        state, metrics = trainer.jitted(state, trainer.hyper())
+        out.append({k: float(np.sum(v)) for k, v in jax.device_get(metrics).items()})  # select_steps: per iteration
+    return state, out
+
+
+@pytest.fixture(scope="module")
+def learned(trainer):
+    return run_chunks(trainer, 0, 4)
+
+
+def test_chunk_compiles_once_and_is_not_retraced(trainer, learned):
+    assert trainer.traces == 1
+    run_chunks(trainer, 1, 1)
+    assert trainer.traces == 1
+
+
+def test_splid_learns_well_above_a_random_policy(trainer, learned):
+    _, metrics = learned
+    baseline = random_policy_success(trainer.env)
+    final = metrics[-1]["eval_success"]
+    assert final > baseline + 0.3, (final, baseline)
+    assert final > metrics[0]["eval_success"] - 0.05
+    assert metrics[-1]["buffer_size"] > 0 and metrics[-1]["finite"] == 1.0
+
+
+def test_same_seed_same_metrics_different_seed_different(trainer, learned):
+    state0, metrics0 = learned
+    state_again, metrics_again = run_chunks(trainer, 0, 4)
+    assert metrics_again == metrics0
+    np.testing.assert_array_equal(
+        jax.tree_util.tree_leaves(state0.policy.params)[0], jax.tree_util.tree_leaves(state_again.policy.params)[0]
+    )
+    _, metrics1 = run_chunks(trainer, 1, 1)
+    assert metrics1[0] != metrics0[0]
+
+
+def test_select_accepts_fewer_pairs_than_the_ablation(trainer, learned):
+    ablation = Trainer(trainer.env, TrainConfig(**{**CFG, "select": False, "iterations": 10}))
+    state = trainer.init(jax.random.PRNGKey(0))
+    _, with_select = trainer.jitted(state, trainer.hyper())
+    _, without = jax.jit(ablation.chunk)(state, ablation.hyper())
+    assert int(without["select_accepted"]) == int(without["select_pairs"])
+    assert int(with_select["select_accepted"]) < int(with_select["select_pairs"])
+    assert int(with_select["select_accepted"]) < int(without["select_accepted"])
+
+
+def test_exploration_noise_falls_linearly_to_its_end_fraction_and_stays():
+    t = Trainer(envs.make("point"), TrainConfig(**{**CFG, "sigma": 2.0, "sigma_end": 0.25, "sigma_anneal": 11}))
+    sigma = [float(t.sigma_at(jnp.int32(i), t.hyper())) for i in (0, 5, 10, 30)]
+    np.testing.assert_allclose(sigma, [2.0, 1.25, 0.5, 0.5], rtol=1e-6)
+    state, metrics = jax.jit(t.chunk)(t.init(jax.random.PRNGKey(0)), t.hyper())  # eval_every 10 iterations
+    assert float(metrics["sigma"]) == pytest.approx(2.0 * (1 - 0.75 * 0.9))  # the last one's: iteration 9
+    constant = Trainer(envs.make("point"), TrainConfig(**CFG))
+    assert float(constant.sigma_at(jnp.int32(30), constant.hyper())) == 1.0

@@ -1,0 +1,64 @@
+"""The registry is the one table of learners: each name builds its own learner from its own settings,
+and what a learner does not read is refused, whatever the name."""
+
+import dataclasses
+
+import pytest
+
+import envs
+from splid_jax.common.errors import InvalidConfig
+from splid_jax.config import TrainConfig
+from splid_jax.learners import registry
+from splid_jax.learners.es.config import EsConfig
+from splid_jax.learners.es.learner import ES
+from splid_jax.learners.her.config import HerConfig
+from splid_jax.learners.her.learner import HER
+from splid_jax.learners.imitation.config import ImitationConfig
+from splid_jax.learners.splid.trainer import Trainer
+
+EXPECTED = {"splid": (ImitationConfig, Trainer), "gcsl": (ImitationConfig, Trainer),
+            "pchid": (ImitationConfig, Trainer), "her": (HerConfig, HER), "es": (EsConfig, ES)}  # fmt: skip
+
+
+def test_every_name_builds_its_own_learner_from_its_own_settings():
+    assert registry.names() == list(EXPECTED)
+    env = envs.make("point")
+    for name, (settings, learner) in EXPECTED.items():
+        cfg = TrainConfig(env="point", algo=name, hidden=(8,) if name != "her" else None)
+        assert type(cfg.learner_config()) is settings
+        algo = registry.make_algorithm(cfg, env)
+        assert type(algo) is learner and algo.name == name
+        hyper = algo.hyper()  # what a sweep's members may hold apart: the learner's traced settings
+        traced = [f.name for f in dataclasses.fields(hyper)] if dataclasses.is_dataclass(hyper) else list(hyper)
+        assert tuple(traced) == registry.get(name).sweeps, name
+
+
+def test_a_learner_reads_its_settings_and_the_runs_and_ignores_the_others():
+    learners_own = {*registry.IMITATION_FIELDS, "her_options", "es_options"}
+    run_fields = [f.name for f in dataclasses.fields(TrainConfig) if f.name not in learners_own]
+    for name in registry.names():
+        assert all(registry.reads(name, f) for f in run_fields if f != "num_envs"), name
+    assert registry.ignores("splid") == ()
+    assert set(registry.ignores("her")) == set(registry.IMITATION_FIELDS)
+    assert set(registry.ignores("es")) == set(registry.IMITATION_FIELDS) - {"hidden"}
+    assert not registry.reads("es", "num_envs") and registry.reads("her", "num_envs")
+
+
+def test_only_the_cloning_learners_split_a_run_and_sweep_sigma_and_h():
+    splits = {name for name, x in registry.LEARNERS.items() if x.splits_envs}
+    assert splits == {"splid", "gcsl", "pchid"}
+    assert all(registry.get(n).sweeps == ("sigma", "horizon") for n in splits)
+    assert [n for n, x in registry.LEARNERS.items() if x.grows_horizon] == ["pchid"]
+    assert [n for n, x in registry.LEARNERS.items() if x.clones_every_pair] == ["gcsl"]
+
+
+def test_an_unknown_name_fails_naming_the_field():
+    with pytest.raises(InvalidConfig, match="invalid algo='ppo': must be one of splid, gcsl, pchid, her, es"):
+        registry.get("ppo")
+
+
+@pytest.mark.parametrize("field, value", [("policy_ema", 1.0), ("relabel", "nearest"), ("bc_steps", -1)])
+def test_the_cloning_settings_are_checked_on_construction(field, value):
+    good = TrainConfig(env="point").learner_config()
+    with pytest.raises(InvalidConfig, match=f"invalid {field}="):
+        dataclasses.replace(good, **{field: value})

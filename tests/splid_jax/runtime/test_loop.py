@@ -1,0 +1,244 @@
+"""The host loop with a toy algorithm that compiles in a moment: one schema for a run and a sweep,
+resume bit for bit (a sweep too), a torn metrics line, refusals before any write, NaN, signals."""
+
+import dataclasses
+import json
+import logging
+import os
+import signal
+import threading
+import time
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import envs
+from splid_jax.common.errors import InvalidConfig
+from splid_jax.config import TrainConfig
+from splid_jax.learners.base import EVAL_KEYS
+from splid_jax.runtime import checkpoint, loop, run_files
+from splid_jax.runtime.signals import Signals
+
+ENV = envs.make("point")
+
+
+@dataclasses.dataclass
+class Toy:
+    """An ``learners.base.Algorithm`` with a random walk for training; ``nan_at`` poisons it at an iteration."""
+
+    env: object
+    cfg: TrainConfig
+    nan_at: int = -1
+    sleep: float = 0.0  # seconds each chunk waits in a host callback, to be long enough to interrupt
+    name = "toy"
+
+    def init(self, key):
+        # "scale" is weakly typed, as leaves of a real init can be: a restored one must compile the same
+        return {"w": jnp.zeros(3), "scale": jnp.asarray(1.0), "key": key, "iteration": jnp.int32(0)}
+
+    def hyper(self):
+        return {"sigma": jnp.float32(self.cfg.sigma)}
+
+    def chunk(self, state, hyper):
+        def one(s, _):
+            key, k = jax.random.split(s["key"])
+            w = s["w"] + s["scale"] * hyper["sigma"] * jax.random.normal(k, s["w"].shape)
+            w = jnp.where(s["iteration"] + 1 == self.nan_at, jnp.nan, w)
+            return {**s, "w": w, "key": key, "iteration": s["iteration"] + 1}, jnp.int32(7)
+
+        s, steps = jax.lax.scan(one, state, None, length=self.cfg.eval_every)
+        if self.sleep:
+            pause = lambda w: (time.sleep(self.sleep), w)[1]  # noqa: E731
+            s = {**s, "w": jax.pure_callback(pause, jax.ShapeDtypeStruct(s["w"].shape, jnp.float32), s["w"])}
+        metrics = {
+            "eval_success": jnp.tanh(jnp.abs(s["w"]).mean()),
+            "eval_success_final": jnp.tanh(jnp.abs(s["w"].ravel()[0])),
+            "eval_return": s["w"].sum(),
+            "toy_loss": s["w"].ravel()[1],
+            "select_steps": steps,
+            "finite": jnp.all(jnp.isfinite(s["w"])),
+        }
+        return s, metrics
+
+    def counters(self, iteration, select_steps):
+        n = self.cfg.num_envs
+        return {"iteration": iteration, "episodes": iteration * n, "env_steps": iteration * n * 50,
+                "select_steps": select_steps}  # fmt: skip
+
+
+def config(tmp_path, name="run", **kw):
+    return TrainConfig(**{"env": "point", "num_envs": 4, "eval_every": 2, "iterations": 6, "eval_episodes": 4,
+                          "run_dir": str(tmp_path / name), **kw})  # fmt: skip
+
+
+def run(cfg, members=None, resume=False, **kw):
+    return loop.run(cfg, ENV, algo=Toy(ENV, cfg, **kw), members=members, resume=resume, quiet=True)
+
+
+def sweep_lanes(cfg, sigmas=(0.5, 1.0), seeds=(0, 1)):
+    return [dataclasses.replace(cfg, sigma=sg, seed=s, run_dir=os.path.join(cfg.run_dir, f"sigma{sg}-s{s}"))
+            for sg in sigmas for s in seeds]  # fmt: skip
+
+
+def records(run_dir):
+    return run_files.read_metrics(os.path.join(run_dir, run_files.METRICS))
+
+
+def without_time(recs):
+    return [{k: v for k, v in r.items() if k not in ("wall_s", "steps_per_s")} for r in recs]
+
+
+def restored(run_dir, like):
+    return checkpoint.restore(run_dir, like)[1]
+
+
+def test_one_schema_for_a_run_and_a_sweep(tmp_path):
+    cfg = config(tmp_path)
+    one = run(cfg)[0]
+    lanes = sweep_lanes(config(tmp_path, "sweep"))
+    many = run(config(tmp_path, "sweep"), members=lanes)
+    assert list(one) == list(many[0])
+    assert list(one)[:7] == ["iteration", "episodes", "env_steps", "select_steps", *EVAL_KEYS]
+    assert list(one)[-2:] == ["steps_per_s", "wall_s"] and "toy_loss" in one and "finite" not in one
+    assert one["select_steps"] == 6 * 7 and one["episodes"] == 24
+    recs = {os.path.basename(m.run_dir): records(m.run_dir) for m in lanes}
+    assert all(len(r) == 3 for r in recs.values())
+    assert recs["sigma0.5-s0"] != recs["sigma0.5-s1"] and recs["sigma0.5-s0"] != recs["sigma1.0-s0"]
+    # a member trains as the same config would alone, bit for bit
+    alone = config(tmp_path, "alone", sigma=1.0, seed=1)
+    run(alone)
+    assert without_time(records(alone.run_dir)) == without_time(recs["sigma1.0-s1"])
+    saved = json.loads((tmp_path / "sweep" / "sigma0.5-s1" / "config.json").read_text())
+    assert (saved["sigma"], saved["seed"]) == (0.5, 1)
+
+
+@pytest.mark.parametrize("sweep", [False, True], ids=["run", "sweep"])
+def test_resume_continues_bit_for_bit_and_compiles_the_chunk_once(tmp_path, caplog, sweep):
+    whole, part = config(tmp_path, "whole"), config(tmp_path, "part", iterations=2)
+
+    def lanes(c):
+        return sweep_lanes(c) if sweep else None
+
+    run(whole, lanes(whole))
+    run(part, lanes(part))
+    longer = dataclasses.replace(part, iterations=6)
+    jax.config.update("jax_log_compiles", True)  # globally: the loop compiles in a thread of its own
+    try:
+        with caplog.at_level(logging.WARNING):
+            run(longer, lanes(longer), resume=True)
+    finally:
+        jax.config.update("jax_log_compiles", False)
+    assert sum("Compiling jit(chunk)" in r.getMessage() for r in caplog.records) == 1
+    like = jax.eval_shape(Toy(ENV, whole).init, jax.random.PRNGKey(0))
+    if sweep:
+        like = jax.tree.map(lambda x: jax.ShapeDtypeStruct((4, *x.shape), x.dtype), like)
+    for a, b in zip(jax.tree.leaves(restored(whole.run_dir, like)), jax.tree.leaves(restored(part.run_dir, like)),
+                    strict=True):  # fmt: skip
+        np.testing.assert_array_equal(a, b)
+    for w, p in zip(lanes(whole) or [whole], lanes(longer) or [longer], strict=True):
+        assert without_time(records(w.run_dir)) == without_time(records(p.run_dir))
+
+
+def test_a_torn_last_line_is_dropped_on_resume(tmp_path):
+    cfg = config(tmp_path, iterations=4)
+    run(cfg)
+    path = os.path.join(cfg.run_dir, run_files.METRICS)
+    with open(path, "a") as fh:
+        fh.write('{"iteration": 6, "episo')  # killed mid-write
+    run(dataclasses.replace(cfg, iterations=6), resume=True)
+    assert [r["iteration"] for r in records(cfg.run_dir)] == [2, 4, 6]
+    assert open(path).read().endswith("}\n")
+
+
+def test_a_finished_run_is_already_complete_and_left_untouched(tmp_path, capsys):
+    cfg = config(tmp_path)
+    run(cfg)
+    before = {p: (tmp_path / "run" / p).read_bytes() for p in ("config.json", run_files.METRICS)}
+    last = loop.run(cfg, ENV, algo=Toy(ENV, cfg), resume=True)
+    assert "already complete" in capsys.readouterr().out
+    assert last[0]["iteration"] == 6
+    assert {p: (tmp_path / "run" / p).read_bytes() for p in before} == before
+    with pytest.raises(InvalidConfig, match=r"invalid iterations=4: must be >= 6"):
+        run(dataclasses.replace(cfg, iterations=4), resume=True)
+    assert {p: (tmp_path / "run" / p).read_bytes() for p in before} == before
+
+
+def test_a_run_never_overwrites_another(tmp_path):
+    cfg = config(tmp_path, iterations=2)
+    run(cfg)
+    with pytest.raises(InvalidConfig, match="run_dir"):  # a checkpoint is there
+        run(cfg)
+    lonely = tmp_path / "metrics-only"
+    lonely.mkdir()
+    (lonely / run_files.METRICS).write_text('{"iteration": 2}\n' * 30)
+    with pytest.raises(InvalidConfig, match="run_dir.*metrics.jsonl"):
+        run(config(tmp_path, "metrics-only"))
+    assert (lonely / run_files.METRICS).read_text() == '{"iteration": 2}\n' * 30
+    sweep = config(tmp_path, "sweep", iterations=2)
+    run(sweep, sweep_lanes(sweep))
+    kept = records(sweep_lanes(sweep)[0].run_dir)
+    other = config(tmp_path, "sweep", iterations=2, checkpoint_every=0)
+    with pytest.raises(InvalidConfig, match="run_dir"):
+        run(other, sweep_lanes(other, sigmas=(2.0,)))
+    assert records(sweep_lanes(sweep)[0].run_dir) == kept
+
+
+@pytest.mark.parametrize("run_dir", ["/proc/splid-run", "/proc/self/splid/run"])
+def test_a_run_dir_that_cannot_be_written_is_refused_before_any_work(run_dir):
+    cfg = TrainConfig(env="point", run_dir=run_dir)
+    with pytest.raises(InvalidConfig, match="run_dir.*writable"):
+        loop.check_writable(cfg.run_dir)
+
+
+def test_writability_probe_leaves_nothing_behind(tmp_path):
+    loop.check_writable(str(tmp_path / "a" / "b"))
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_run_too_large_for_the_device_is_refused_with_its_estimate(tmp_path):
+    cfg = config(tmp_path)
+    toy = Toy(ENV, cfg)
+    toy.init = lambda key: {"w": jnp.zeros((10**7, 10**5)), "scale": 1.0, "key": key, "iteration": jnp.int32(0)}
+    with pytest.raises(InvalidConfig, match=r"needs at least \d+\.\d GB .* is \d+\.\d GB"):
+        loop.run(cfg, ENV, algo=toy, quiet=True)
+    assert not os.path.exists(cfg.run_dir)
+
+
+def test_nan_stops_the_run_and_keeps_the_last_good_state(tmp_path):
+    cfg = config(tmp_path, checkpoint_every=0)
+    with pytest.raises(loop.RunStopped, match="non-finite .* after iteration 4.*iteration 2"):
+        run(cfg, nan_at=3)
+    assert checkpoint.latest_step(cfg.run_dir) == 2
+    assert [r["iteration"] for r in records(cfg.run_dir)] == [2]
+
+
+def test_a_signal_during_a_chunk_saves_the_newest_whole_state(tmp_path):
+    cfg = config(tmp_path, iterations=400, checkpoint_every=0)
+    toy = Toy(ENV, cfg, sleep=0.2)
+    path = os.path.join(cfg.run_dir, run_files.METRICS)
+
+    def send():
+        while not (os.path.exists(path) and records(cfg.run_dir)[-1:] and records(cfg.run_dir)[-1]["iteration"] >= 4):
+            time.sleep(0.01)
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    threading.Thread(target=send, daemon=True).start()
+    with pytest.raises(loop.Interrupted) as info:
+        loop.run(cfg, ENV, algo=toy, quiet=True)
+    assert info.value.exit_code == 143
+    step = checkpoint.latest_step(cfg.run_dir)
+    assert step == records(cfg.run_dir)[-1]["iteration"] >= 4
+
+
+def test_signals_stop_a_wait_at_once():
+    before = signal.getsignal(signal.SIGINT)  # ignored where pytest runs as a background job
+    with Signals() as signals:
+        threading.Timer(0.2, os.kill, (os.getpid(), signal.SIGINT)).start()
+        finished = threading.Event()
+        with pytest.raises(loop.Interrupted) as info:
+            signals.wait(lambda: (time.sleep(5), finished.set()))
+        assert not finished.is_set()  # the wait ended with the signal, not with the work
+    assert info.value.exit_code == 130
+    assert signal.getsignal(signal.SIGINT) is before
