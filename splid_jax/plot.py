@@ -20,6 +20,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg
 
+from splid_jax.common import stats
+from splid_jax.common.stats import smooth
 from splid_jax.runtime import progress
 
 DESCRIPTION = (
@@ -130,16 +132,6 @@ def labels(runs: Sequence[Run]) -> tuple[list[str], list[str]]:
     return full, group
 
 
-def smooth(y: np.ndarray, k: int) -> np.ndarray:
-    """Trailing mean over the last ``k`` evaluations (fewer at the start), so no point sees the future."""
-    if k <= 1:
-        return y
-    c = np.cumsum(np.insert(y, 0, 0.0))
-    i = np.arange(1, len(y) + 1)
-    lo = np.maximum(i - k, 0)
-    return (c[i] - c[lo]) / (i - lo)
-
-
 @dataclasses.dataclass(frozen=True)
 class Curve:
     label: str
@@ -164,17 +156,14 @@ def _curves(runs: Sequence[Run], k: int, group: bool) -> list[Curve]:
         if len(group_cols) == 1:
             curves.append(Curve(f"{key} (1 run)", group_cols[0]))
             continue
-        # Average evaluations all members reached, so the mean never mixes in fewer runs.
-        common = sorted(set.intersection(*(set(c["iteration"].tolist()) for c in group_cols)))
-        stacked = {
-            m: np.stack([c[m][np.searchsorted(c["iteration"], common)] for c in group_cols]) for m in group_cols[0]
-        }
+        stacked = stats.aligned(group_cols, group_cols[0], stats.common_iterations(group_cols))
+        bands = {m: stats.band(v) for m, v in stacked.items()}
         curves.append(
             Curve(
                 f"{key} ({len(group_cols)} runs)",
-                {m: v.mean(0) for m, v in stacked.items()},
-                {m: v.min(0) for m, v in stacked.items()},
-                {m: v.max(0) for m, v in stacked.items()},
+                {m: stats.mean(v) for m, v in stacked.items()},
+                {m: low for m, (low, _) in bands.items()},
+                {m: high for m, (_, high) in bands.items()},
             )
         )
     return curves

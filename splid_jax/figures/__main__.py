@@ -1,0 +1,9 @@
+"""``python -m splid_jax.figures FIG ...``: the command line."""
+
+from splid_jax.cli import exit_with, quiet_interrupts
+
+if __name__ == "__main__":
+    quiet_interrupts()  # before the figure modules load JAX: a signal then ends the process with one line
+    from splid_jax.figures.cli import main
+
+    exit_with(main())

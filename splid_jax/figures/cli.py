@@ -1,0 +1,169 @@
+"""``python -m splid_jax.figures``: its flags, its help, and what each exit code means."""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import os
+import shlex
+import sys
+from collections.abc import Sequence
+
+import envs
+from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache
+from splid_jax.common.errors import InvalidConfig, check
+from splid_jax.figures.drawing import render
+from splid_jax.figures.merging import merge
+from splid_jax.figures.planning import QUICK_EPISODES, default_budget, describe, device_name, plan
+from splid_jax.figures.record import check_out, load_record
+from splid_jax.figures.registry import METHODS, SPECS
+from splid_jax.figures.runs import train
+from splid_jax.figures.settings import parse_methods, parse_sets, parse_values
+from splid_jax.runtime import checkpoint, loop, progress
+
+HELP = """\
+fig3: SPLID, GCSL, PCHID, HER, ES and SPLID without SELECT, success at any step and at the final step
+      (GCSL pairs each step with the episode's last state, as the paper describes it: --set gcsl.gcsl_relabel=future
+      for the original's future states).
+fig4: SPLID with H in 1, 2, 4, 8, 16 (one sweep; every member replays at the largest H's cost: on an H100
+      Slide's 25 members took 3.5x the time per member of Figure 5's at H = 8; --values subsets joined
+      with --merge run each at its own cost).
+fig5: SPLID with sigma in 0.25, 0.5, 1, 2 (one sweep).
+fig6: average return of SPLID with and without SELECT.
+fig8, fig9: SPLID and GCSL, average return (the paper's Figure 8) and success (Figure 9) from the same
+      runs in one figure; the paper's tasks are point, reacher and sawyer_door.
+
+Each method is one vmapped sweep in OUT/METHOD/ (the sweep's checkpoints, one run directory per
+member); OUT/figure.json records the command, device, date and what each method ran; the PNG and the
+CSV (method, episodes, mean and standard error of each measure, seeds, wall-clock seconds of training
+without compilation, iterations and episodes each method ran) lie in OUT.
+A figure too long for one machine or call can be trained as --methods (fig3) or --values (fig4, fig5)
+subsets, each in its own --out, and joined with --merge (figN --merge DIR1 DIR2 ... --out OUT).
+Exit codes: 0 done, 2 bad input (nothing trained), 3 a run stopped (NaN), 130 Ctrl-C, 143 SIGTERM
+(each method's newest state is kept; --resume continues)."""
+
+
+def build_parser() -> Parser:
+    parser = Parser(
+        prog="python -m splid_jax.figures",
+        description="The paper's figures from one command each: every method trained with the same budget of "
+        "exploration episodes through the one host loop, several seeds as one vmapped program, mean and standard "
+        "error against episodes, a PNG and a CSV.",
+        epilog=HELP,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("figure", choices=sorted(SPECS), help="which figure")
+    parser.add_argument(
+        "--env", default=None, help="task: " + ", ".join(envs.names()) + " (default push; fig8, fig9, --quick: point)"
+    )
+    parser.add_argument(
+        "--methods", default=None, help="fig3: a comma-separated subset of " + ", ".join(METHODS) + " (default: all)"
+    )
+    parser.add_argument("--seeds", type=int, default=5, help="seeds per method or setting (default: 5)")
+    parser.add_argument(
+        "--episodes",
+        type=int,
+        default=None,
+        metavar="N",
+        help="exploration episodes per method (default: push 20,000, slide and pick_and_place "
+        "100,000, other tasks their default run's; --quick: 320); each method's iterations are "
+        "N / its episodes per iteration, rounded to whole chunks of eval_every iterations",
+    )
+    parser.add_argument(
+        "--values", default=None, help="fig4: H values (default 1,2,4,8,16); fig5: sigma values (default 0.25,0.5,1,2)"
+    )
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="[METHOD.]FIELD=VALUE",
+        help="a training setting (a TrainConfig field, as python -m splid_jax.train --help lists "
+        "them) for every method, or with METHOD. for one; repeatable",
+    )
+    parser.add_argument(
+        "--quick",
+        action="store_true",
+        help="the point task with a tiny budget and small networks: the same code in a few minutes "
+        "on a CPU (out: runs/DATE/FIG-point-quick)",
+    )
+    parser.add_argument(
+        "--out", default=None, metavar="DIR", help="a new or empty directory (default experiments/results/DATE/FIG-ENV)"
+    )
+    parser.add_argument("--replot", action="store_true", help="redraw the figure and CSV in --out from its runs")
+    parser.add_argument("--resume", action="store_true", help="continue the figure in --out where its runs stopped")
+    parser.add_argument(
+        "--merge",
+        nargs="+",
+        default=None,
+        metavar="DIR",
+        help="join figure directories trained with distinct --methods (fig3) or --values (fig4, fig5; each "
+        "value then a sweep of its own shapes), on other machines or in other calls, into --out, a new "
+        "directory, and draw them as one figure; the parts are copied, not moved",
+    )
+    parser.add_argument("--quiet", action="store_true", help="no progress display")
+    add_compile_cache_flag(parser)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    ns = parser.parse_args(argv)
+    spec = SPECS[ns.figure]
+    today = datetime.date.today().isoformat()
+    env_name = ns.env or ("point" if ns.quick or ns.figure in ("fig8", "fig9") else "push")
+    out = ns.out or (
+        os.path.join("runs", today, f"{ns.figure}-{env_name}-quick")
+        if ns.quick
+        else os.path.join("experiments", "results", today, f"{ns.figure}-{env_name}")
+    )
+    use_compile_cache(ns.compile_cache)
+    try:
+        if ns.merge:
+            check(not (ns.replot or ns.resume), "merge", " ".join(ns.merge), "given without --replot or --resume")
+            check(ns.out is not None, "out", None, "the new directory --merge joins the parts into")
+            merge(out, ns.merge, ns.figure, shlex.join(["python", "-m", "splid_jax.figures", *argv]))
+        elif ns.replot or ns.resume:
+            check(not (ns.replot and ns.resume), "replot", True, "given without --resume")
+            if ns.resume:
+                train(out, load_record(out), ns.quiet, resume=True)
+        else:
+            check(env_name in envs.names(), "env", env_name, "one of " + ", ".join(envs.names()))
+            check(not ns.quick or env_name == "point", "env", env_name, "point with --quick")
+            if ns.methods is None:
+                methods = spec.methods
+            else:
+                check(ns.figure == "fig3", "methods", ns.methods, "given only for fig3")
+                methods = parse_methods(ns.methods, spec.methods)
+            budget = ns.episodes
+            if budget is None:
+                budget = QUICK_EPISODES if ns.quick else default_budget(env_name)
+            sets = parse_sets(ns.set, methods)
+            values = parse_values(spec, ns.values)
+            check_out(out)
+            plans = plan(spec, env_name, methods, ns.seeds, budget, sets, out, values, ns.quick)
+            record = {
+                "figure": ns.figure,
+                "env": env_name,
+                "methods": list(methods),
+                "seeds": ns.seeds,
+                "budget_episodes": budget,
+                "device": device_name(),
+                "date": today,
+                "command": shlex.join(["python", "-m", "splid_jax.figures", *argv]),
+                "runs": describe(plans),
+            }
+            os.makedirs(out, exist_ok=True)
+            train(out, record, ns.quiet)
+        png, table = render(out, ns.quiet)
+    except InvalidConfig as err:
+        print(f"{parser.prog}: error: {err}", file=sys.stderr)
+        return 2
+    except loop.Interrupted as stop:
+        progress.show(f"stopped; continue with: python -m splid_jax.figures {ns.figure} --out {out} --resume", ns.quiet)
+        return stop.exit_code
+    except (loop.RunStopped, checkpoint.CheckpointError) as err:
+        print(f"{parser.prog}: error: {err}", file=sys.stderr)
+        return 3
+    progress.show(f"figure: {png}\ntable: {table}", ns.quiet)
+    return 0
