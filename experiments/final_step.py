@@ -184,6 +184,7 @@ def main() -> None:
     for spec in a.set or [""]:
         r = run_arm(a.env, a.seeds, base, parse_set(spec), a.trace_episodes, a.first_seed)
         name = "-".join(f"{k}{v}" for k, v in r["fields"].items()) or "default"
+        name = "".join(c if c.isalnum() or c in "._-" else "_" for c in name)  # a file name, whatever the values
         with open(os.path.join(a.out, f"{a.env}-{name}.json"), "w") as fh:
             json.dump(r, fh)
         results.append(r)
