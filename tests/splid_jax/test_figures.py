@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from splid_jax import figures
+from splid_jax.figures import runs as figure_runs
 from splid_jax.runtime import loop
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -253,7 +254,7 @@ def test_a_stopped_method_keeps_its_seconds_for_the_resumed_total(tmp_path, monk
         raise loop.Interrupted(15)
 
     monkeypatch.setattr(loop, "run", stopped)
-    monkeypatch.setattr(figures.time, "perf_counter", lambda: clock[0])
+    monkeypatch.setattr(figure_runs.time, "perf_counter", lambda: clock[0])
     assert figures.main(["fig3", "--methods", "gcsl", "--out", str(out), *QUICK]) == 143
     assert json.loads((out / "figure.json").read_text())["runs"]["gcsl"]["total_s"] == 2.5
     assert figures.main(["fig3", "--resume", "--out", str(out), "--quiet"]) == 143
