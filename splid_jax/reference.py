@@ -1,0 +1,517 @@
+"""Evaluate a run's policy in the reference simulator, Gymnasium-Robotics ``Fetch*-v4`` (MuJoCo C, the
+7-joint arm on its mocap weld), beside the same numbers in our MJX task; and trace both simulators
+from the same starts.
+
+``python -m splid_jax.evaluate RUN_DIR --reference`` needs the optional extra
+(``pip install -e ".[reference]"``: gymnasium-robotics 1.4.2, which installs beside our mujoco).
+
+Run-time fix. gymnasium-robotics 1.4.2's joint getters and setters (``utils/mujoco_utils.py``)
+assert ``joint_type in (mjJNT_HINGE, mjJNT_SLIDE)``, which is False for the numpy integer that mujoco
+>= 3.12 returns, so every ``Fetch*-v4`` fails when it is made. ``fix_joint_type_asserts`` probes
+that failure on a one-joint model and, only where it occurs, replaces the four functions in that
+module (in memory; site-packages is never edited) by ones that compare ``int(joint_type)``.
+
+Observation mapping. Our tasks emit the reference's layout, so the policy is fed the reference's raw
+``observation`` and ``desired_goal`` (float32) and applies its own input processing inside
+``Policy.act`` (normaliser, goal relative to the achieved goal), exactly as in training:
+
+  [0:3] grip site position        [3:6] object position        [6:9] object - grip
+  [9:11] finger joints            [11:14] object Euler angles  [14:17] object - grip velocity
+  [17:20] object angular velocity [20:23] grip velocity        [23:25] finger velocities
+  (velocities in metres or radians per 0.04 s control step; Reach: grip, fingers, grip and finger
+  velocity, 10 floats). achieved_goal = object position (grip position for Reach), desired_goal 3.
+
+Actions: 4 floats clipped to [-1, 1] (``Policy.act`` clips); ``a[:3]`` moves the gripper target by
+0.05 a metres, ``a[3]`` drives the fingers (ignored, fingers locked, in Reach, Push and Slide).
+
+Same start. ``reference_start`` sets the reference, after its own ``reset``, to our task's sampled
+start: the object's x-y (its height and orientation stay the reference's resting ones) and the goal,
+both moved by the difference of the two simulators' gripper homes (and, in z, object rest heights);
+the gripper starts at each simulator's home.
+
+Differences measured (the traces from the same starts; numbers in ``BENCHMARKS.md``):
+DIFFERENCES
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import dataclasses
+import io
+import json
+import math
+import os
+import sys
+import tempfile
+
+import numpy as np
+
+from envs.base import InvalidConfig
+
+REFERENCE_IDS = {
+    "reach": "FetchReach-v4",
+    "push": "FetchPush-v4",
+    "slide": "FetchSlide-v4",
+    "pick_and_place": "FetchPickAndPlace-v4",
+}
+EXTRA = 'pip install -e ".[reference]"'
+Z95 = 1.959963984540054  # the normal quantile of a two-sided 95 % interval
+
+
+class EvaluationError(ValueError):
+    """A user mistake the command reports in one line (exit code 2)."""
+
+
+# ---- the run-time fix ------------------------------------------------------------------------------
+_QPOS_SIZE = {0: 7, 1: 4, 2: 1, 3: 1}  # mjtJoint: free, ball, slide, hinge
+_QVEL_SIZE = {0: 6, 1: 3, 2: 1, 3: 1}
+
+
+def _joint(model, name: str, sizes: dict, address) -> tuple[int, int]:
+    import mujoco
+
+    joint_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
+    assert joint_id != -1, f"Joint with name '{name}' is not part of the model!"
+    start = int(address[joint_id])
+    return start, start + sizes[int(model.jnt_type[joint_id])]
+
+
+def _set_joint_qpos(model, data, name, value):
+    start, end = _joint(model, name, _QPOS_SIZE, model.jnt_qposadr)
+    data.qpos[start:end] = np.asarray(value)
+
+
+def _set_joint_qvel(model, data, name, value):
+    start, end = _joint(model, name, _QVEL_SIZE, model.jnt_dofadr)
+    data.qvel[start:end] = np.asarray(value)
+
+
+def _get_joint_qpos(model, data, name):
+    start, end = _joint(model, name, _QPOS_SIZE, model.jnt_qposadr)
+    return data.qpos[start:end].copy()
+
+
+def _get_joint_qvel(model, data, name):
+    start, end = _joint(model, name, _QVEL_SIZE, model.jnt_dofadr)
+    return data.qvel[start:end].copy()
+
+
+_PROBE = '<mujoco><worldbody><body><joint name="s" type="slide"/><geom size="0.1"/></body></worldbody></mujoco>'
+
+
+def joint_getters_fail(mujoco_utils) -> bool:
+    """Whether ``mujoco_utils.get_joint_qpos`` fails on a slide joint (mujoco >= 3.12's numpy joint type)."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_string(_PROBE)
+    try:
+        mujoco_utils.get_joint_qpos(model, mujoco.MjData(model), "s")
+    except AssertionError:
+        return True
+    return False
+
+
+def fix_joint_type_asserts(mujoco_utils=None) -> bool:
+    """Replace gymnasium-robotics' four joint getters/setters, in memory, by ones comparing
+    ``int(joint_type)``, if they fail on this mujoco; True when it replaced them. The Fetch envs look
+    them up through the module (``self._utils``), so the replacement reaches them."""
+    if mujoco_utils is None:
+        from gymnasium_robotics.utils import mujoco_utils
+    if not joint_getters_fail(mujoco_utils):
+        return False
+    mujoco_utils.set_joint_qpos = _set_joint_qpos
+    mujoco_utils.set_joint_qvel = _set_joint_qvel
+    mujoco_utils.get_joint_qpos = _get_joint_qpos
+    mujoco_utils.get_joint_qvel = _get_joint_qvel
+    return True
+
+
+# ---- the reference simulator -----------------------------------------------------------------------
+def reference_id(task: str) -> str:
+    if task not in REFERENCE_IDS:
+        raise EvaluationError(
+            f"task {task!r} has no reference simulator (only {', '.join(REFERENCE_IDS)} have a Fetch*-v4)"
+        )
+    return REFERENCE_IDS[task]
+
+
+def make_reference(task: str):
+    """The ``Fetch*-v4`` env matching our ``task``, with the run-time fix applied where needed."""
+    env_id = reference_id(task)
+    try:
+        import gymnasium as gym
+        import gymnasium_robotics
+    except ImportError:
+        raise EvaluationError(f"the reference simulator is not installed: {EXTRA}") from None
+    fix_joint_type_asserts()
+    gym.register_envs(gymnasium_robotics)
+    return gym.make(env_id)
+
+
+def reference_start(env, home_shift: np.ndarray, object_xy: np.ndarray | None, goal: np.ndarray,
+                    rest_shift: float = 0.0) -> dict:  # fmt: skip
+    """Put the reference env (already ``reset``) at our start: object x-y and goal, moved by
+    ``home_shift`` (reference grip home - ours) and, for goals on the table, ``rest_shift`` in z
+    (reference object rest height - ours). Returns its observation dict."""
+    import mujoco
+
+    u = env.unwrapped
+    if object_xy is not None:
+        from gymnasium_robotics.utils import mujoco_utils
+
+        q = mujoco_utils.get_joint_qpos(u.model, u.data, "object0:joint")
+        q[:2] = np.asarray(object_xy, np.float64) + home_shift[:2]
+        mujoco_utils.set_joint_qpos(u.model, u.data, "object0:joint", q)
+        mujoco_utils.set_joint_qvel(u.model, u.data, "object0:joint", np.zeros(6))
+    u.goal = np.asarray(goal, np.float64) + home_shift + np.array([0.0, 0.0, rest_shift])
+    mujoco.mj_forward(u.model, u.data)
+    return u._get_obs()
+
+
+@dataclasses.dataclass(frozen=True)
+class Episodes:
+    """Batched episodes of one simulator, numpy: obs [E, T + 1, O], achieved [E, T + 1, 3],
+    goal [E, 3], success [E, T] (after each step), actions [E, T, 4]."""
+
+    obs: np.ndarray
+    achieved: np.ndarray
+    goal: np.ndarray
+    success: np.ndarray
+    actions: np.ndarray
+    dt: float
+
+    def summary(self) -> dict:
+        return summarise(self.success.any(axis=1), self.success[:, -1], final_distance(self))
+
+
+def final_distance(ep: Episodes) -> np.ndarray:
+    return np.linalg.norm(ep.achieved[:, -1] - ep.goal, axis=-1)
+
+
+def run_reference(task: str, act, episodes: int, seed: int, starts: dict | None = None,
+                  batch: int = 50) -> Episodes:  # fmt: skip
+    """``episodes`` of ``act(obs [B, O], goal [B, 3]) -> actions [B, 4]`` in the reference, ``batch``
+    envs in lockstep (episodes never end early). Episode i resets with seed ``seed + i`` and, with
+    ``starts`` (``our_starts``), is then put at our i-th start."""
+    envs = [make_reference(task) for _ in range(min(batch, episodes))]
+    steps = envs[0].spec.max_episode_steps
+    out = {k: [] for k in ("obs", "achieved", "goal", "success", "actions")}
+    for first in range(0, episodes, len(envs)):
+        live = envs[: min(len(envs), episodes - first)]
+        dicts = []
+        for j, env in enumerate(live):
+            o, _ = env.reset(seed=seed + first + j)
+            if starts is not None:
+                i = first + j
+                xy = None if starts["object_xy"] is None else starts["object_xy"][i]
+                o = reference_start(env, starts["home_shift"], xy, starts["goal"][i], starts["rest_shift"][i])
+            dicts.append(o)
+        obs = [np.stack([d["observation"] for d in dicts])]
+        ach = [np.stack([d["achieved_goal"] for d in dicts])]
+        goal = np.stack([d["desired_goal"] for d in dicts])
+        succ, acts = [], []
+        for _ in range(steps):
+            a = np.clip(np.asarray(act(obs[-1].astype(np.float32), goal.astype(np.float32)), np.float64), -1, 1)
+            res = [env.step(a[j]) for j, env in enumerate(live)]
+            obs.append(np.stack([r[0]["observation"] for r in res]))
+            ach.append(np.stack([r[0]["achieved_goal"] for r in res]))
+            succ.append([bool(r[4]["is_success"]) for r in res])
+            acts.append(a)
+        out["obs"].append(np.stack(obs, 1))
+        out["achieved"].append(np.stack(ach, 1))
+        out["goal"].append(goal)
+        out["success"].append(np.array(succ).T)
+        out["actions"].append(np.stack(acts, 1))
+    u = envs[0].unwrapped
+    dt = float(u.n_substeps * u.model.opt.timestep)
+    for env in envs:
+        env.close()
+    return Episodes(**{k: np.concatenate(v) for k, v in out.items()}, dt=dt)
+
+
+# ---- our task ----------------------------------------------------------------------------------------
+def our_starts(env, key, episodes: int, reference_env=None):
+    """Our task's starts (``jax.vmap(env.reset)`` of ``episodes`` keys split from ``key``, as the
+    project's evaluation draws them) and, given a reset reference env, what ``reference_start`` needs."""
+    import jax
+
+    start = jax.vmap(env.reset)(jax.random.split(key, episodes))
+    starts = {"state": start, "goal": np.asarray(start.desired_goal, np.float64)}
+    lay = env.layout
+    starts["object_xy"] = np.asarray(start.achieved_goal[:, :2], np.float64) if env.has_object else None
+    if reference_env is not None:
+        u = reference_env.unwrapped
+        starts["home_shift"] = np.asarray(u.initial_gripper_xpos[:3], np.float64) - np.asarray(lay.grip_home)
+        shift = float(u.height_offset) - lay.object_rest_z if env.has_object else 0.0
+        # goals resting on the table move by the rest-height difference, goals in the air by the homes'
+        on_table = np.isclose(starts["goal"][:, 2], lay.object_rest_z) if env.has_object else np.zeros(episodes, bool)
+        starts["rest_shift"] = np.where(on_table, shift - starts["home_shift"][2], 0.0)
+    return starts
+
+
+def run_ours(env, act, start) -> Episodes:
+    """Our task's episodes from the batched ``start`` under ``act(obs, goal) -> action`` (jax)."""
+    import jax
+    import jax.numpy as jnp
+
+    from envs.base import step_batch
+
+    @jax.jit
+    def go(s0):
+        def one(s, _):
+            a = jnp.clip(act(s.obs, s.desired_goal), -1.0, 1.0)
+            nxt = step_batch(env, s, a)
+            return nxt, (nxt, a)
+
+        _, (later, acts) = jax.lax.scan(one, s0, None, length=env.episode_length)
+        return later, acts
+
+    later, acts = go(start)
+    cat = lambda a, b: np.concatenate([np.asarray(a)[:, None], np.moveaxis(np.asarray(b), 0, 1)], 1)  # noqa: E731
+    return Episodes(
+        obs=cat(start.obs, later.obs),
+        achieved=cat(start.achieved_goal, later.achieved_goal),
+        goal=np.asarray(start.desired_goal),
+        success=np.moveaxis(np.asarray(later.success & ~later.invalid), 0, 1),
+        actions=np.moveaxis(np.asarray(acts), 0, 1),
+        dt=float(env.dt),
+    )
+
+
+# ---- statistics -------------------------------------------------------------------------------------
+def wilson(successes: int, n: int, z: float = Z95) -> tuple[float, float]:
+    """Wilson score interval of a binomial proportion: unlike the normal one it stays inside [0, 1]
+    and is not empty at 0 or n successes."""
+    if n <= 0:
+        return (0.0, 1.0)
+    p = successes / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+def summarise(any_step, final_step, distance) -> dict:
+    """Success at any and at the final step with Wilson 95 % intervals, and the median final distance."""
+    any_step, final_step = np.asarray(any_step, bool), np.asarray(final_step, bool)
+    n = int(any_step.size)
+    out = {"episodes": n}
+    for name, hits in (("success_any", any_step), ("success_final", final_step)):
+        out[name] = float(hits.mean())
+        out[name + "_ci95"] = list(wilson(int(hits.sum()), n))
+    out["median_final_distance"] = float(np.median(distance))
+    return out
+
+
+# ---- a run's policy -----------------------------------------------------------------------------------
+def load_run(run_dir: str, step: int | None = None):
+    """(config, our task, algorithm, the policy's ``PolicyState``, step) of the run in ``run_dir``."""
+    from splid_jax import checkpoint
+    from splid_jax.rollout import load_config, load_policy
+
+    if not os.path.isdir(run_dir):
+        raise EvaluationError(f"{run_dir} is not a directory")
+    cfg = load_config(run_dir)
+    reference_id(cfg.env)
+    if checkpoint.latest_step(run_dir) is None:
+        raise EvaluationError(f"{run_dir} holds no checkpoint (train writes them in {run_dir}/checkpoints)")
+    with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
+        env, trainer, state, step = load_policy(cfg, step)
+    pstate = getattr(state, "policy", None)
+    from splid_jax.networks import PolicyState
+
+    if not isinstance(pstate, PolicyState):
+        raise EvaluationError(f"the checkpoint of {run_dir} holds no policy (no networks.PolicyState at .policy)")
+    return cfg, env, trainer, pstate, step
+
+
+def policy_act(trainer, pstate):
+    """The deterministic policy as ``act(obs, goal) -> action``, jitted, batched over leading axes."""
+    import jax
+
+    return jax.jit(lambda o, g: trainer.policy.act(pstate, o, g))
+
+
+def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None = None) -> dict:
+    """The run's policy in the reference (its own resets, seeds ``seed`` ...) and in our task (the
+    project's evaluation draw: ``rollout.rollout`` from ``PRNGKey(seed)``), ``episodes`` each."""
+    import jax
+
+    from splid_jax.rollout import rollout
+
+    cfg, env, trainer, pstate, step = load_run(run_dir, step)
+    make_reference(cfg.env).close()  # a missing extra fails before any work
+    states = jax.jit(lambda ps, k: rollout(env, trainer, ps, k, episodes))(pstate, jax.random.PRNGKey(seed))
+    succ = np.asarray(states.success[1:] & ~states.invalid[1:])
+    dist = np.linalg.norm(np.asarray(states.achieved_goal[-1] - states.desired_goal[-1]), axis=-1)
+    ours = summarise(succ.any(axis=0), succ[-1], dist)
+    ref = run_reference(cfg.env, policy_act(trainer, pstate), episodes, seed).summary()
+    return {
+        "run_dir": run_dir,
+        "algo": cfg.algo,
+        "task": cfg.env,
+        "reference": REFERENCE_IDS[cfg.env],
+        "step": int(step),
+        "seed": seed,
+        "ours": ours,
+        "fetch": ref,
+    }
+
+
+# ---- traces -------------------------------------------------------------------------------------------
+def trace_arrays(ep: Episodes, has_object: bool) -> dict:
+    """Per step (T + 1): achieved-goal-to-goal distance, object speed (m/s; 0 for Reach), grip position."""
+    dist = np.linalg.norm(ep.achieved - ep.goal[:, None], axis=-1)
+    grip = ep.obs[..., 0:3]
+    if has_object:
+        speed = np.linalg.norm(ep.obs[..., 14:17] + ep.obs[..., 20:23], axis=-1) / ep.dt
+    else:
+        speed = np.zeros(dist.shape)
+    return {"distance": dist, "object_speed": speed, "grip": grip, "success": ep.success}
+
+
+def matched_episodes(task_env, task: str, act_jax, act_np, episodes: int, seed: int):
+    """(ours, reference) ``Episodes`` from the same starts and goals: our task's ``reset`` draws
+    them, the reference is put there after its own reset."""
+    import jax
+
+    probe = make_reference(task)
+    probe.reset(seed=seed)
+    starts = our_starts(task_env, jax.random.PRNGKey(seed), episodes, probe)
+    probe.close()
+    ours = run_ours(task_env, act_jax, starts["state"])
+    ref = run_reference(task, act_np, episodes, seed, starts=starts)
+    return ours, ref
+
+
+def traces(task_env, task: str, act_jax, act_np, episodes: int, seed: int) -> dict:
+    """Traces of both simulators from the same starts, keys ``ours_*`` and ``fetch_*`` ([E, T + 1]
+    or [E, T + 1, 3]; ``*_success`` [E, T]) and the start goals."""
+    ours, ref = matched_episodes(task_env, task, act_jax, act_np, episodes, seed)
+    out = {"goal_ours": ours.goal, "goal_fetch": ref.goal}
+    for name, ep in (("ours", ours), ("fetch", ref)):
+        for k, v in trace_arrays(ep, task_env.has_object).items():
+            out[f"{name}_{k}"] = v
+    return out
+
+
+def split_by_final(tr: dict, sim: str) -> dict:
+    """Median distance and object speed per step over the episodes that succeed at the final step and
+    over those that do not (the ones that reached the goal at some step but lost it, separately)."""
+    succ = tr[f"{sim}_success"]
+    groups = {
+        "final": succ[:, -1],
+        "lost": succ.any(axis=1) & ~succ[:, -1],
+        "never": ~succ.any(axis=1),
+    }
+    out = {}
+    for name, mask in groups.items():
+        out[name] = {
+            "episodes": int(mask.sum()),
+            "median_distance": np.median(tr[f"{sim}_distance"][mask], axis=0).tolist() if mask.any() else [],
+            "median_object_speed": np.median(tr[f"{sim}_object_speed"][mask], axis=0).tolist() if mask.any() else [],
+        }
+    return out
+
+
+def step_response(task_env, task: str, action, hold: int = 10, release: int = 10) -> dict:
+    """The grip position's response in both simulators to ``action`` held ``hold`` steps then zero for
+    ``release`` steps, from each one's home: per-step displacement (m) along each axis."""
+    import jax
+    import jax.numpy as jnp
+
+    seq = np.concatenate([np.tile(np.asarray(action, np.float64), (hold, 1)), np.zeros((release, 4))])
+    env = make_reference(task)
+    o, _ = env.reset(seed=0)
+    grip = [o["observation"][:3]]
+    for a in seq:
+        o, *_ = env.step(a)
+        grip.append(o["observation"][:3])
+    env.close()
+    s = task_env.reset(jax.random.PRNGKey(0))
+    step = jax.jit(task_env.step)
+    ours = [np.asarray(s.obs[:3])]
+    for a in seq:
+        s = step(s, jnp.asarray(a, jnp.float32))
+        ours.append(np.asarray(s.obs[:3]))
+    ref_disp, our_disp = np.diff(np.array(grip), axis=0), np.diff(np.array(ours), axis=0)
+    return {"action": list(map(float, action)), "hold": hold, "release": release,
+            "fetch_step": ref_disp.tolist(), "ours_step": our_disp.tolist(),
+            "commanded_per_step": (0.05 * np.asarray(action[:3])).tolist()}  # fmt: skip
+
+
+# ---- command line -------------------------------------------------------------------------------------
+def write_json_atomic(path: str, obj) -> None:
+    folder = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".reference-", suffix=".json")
+    with os.fdopen(fd, "w") as fh:
+        json.dump(obj, fh, indent=1)
+    os.replace(tmp, path)
+
+
+def _line(name: str, s: dict) -> str:
+    lo_a, hi_a = s["success_any_ci95"]
+    lo_f, hi_f = s["success_final_ci95"]
+    return (
+        f"{name:22s} any {s['success_any']:.3f} [{lo_a:.3f}, {hi_a:.3f}]  final {s['success_final']:.3f} "
+        f"[{lo_f:.3f}, {hi_f:.3f}]  median final distance {s['median_final_distance']:.3f} m"
+    )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python -m splid_jax.evaluate",
+        description="Evaluate a run's deterministic policy in the reference simulator (Gymnasium-Robotics "
+        "Fetch*-v4) and in our task, with 95 %% intervals.",
+        allow_abbrev=False,
+    )
+    p.add_argument("run_dir", metavar="RUN_DIR")
+    p.add_argument("--reference", action="store_true", help="run the policy in the matching Fetch*-v4 (needs "
+                   f"{EXTRA})")  # fmt: skip
+    p.add_argument("--episodes", type=int, default=300, help="episodes in each simulator (default: 300)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the episodes' starts and goals (default: 0)")
+    p.add_argument("--step", type=int, default=None, help="checkpoint (iteration) to load (default: the newest)")
+    p.add_argument("--out", default=None, metavar="FILE.json", help="default: RUN_DIR/reference.json")
+    p.add_argument("--traces", default=None, metavar="FILE.npz",
+                   help="also trace both simulators from the same starts and goals (distance to goal, object "
+                   "speed, grip position per step) and the grip's response to a held action")  # fmt: skip
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    from splid_jax.checkpoint import CheckpointError
+
+    p = build_parser()
+    a = p.parse_args(argv)
+    try:
+        if not a.reference:
+            raise EvaluationError("pass --reference (the evaluation in our task alone is what train reports)")
+        if a.episodes < 1:
+            raise EvaluationError(f"--episodes {a.episodes}: must be >= 1")
+        out = a.out or os.path.join(a.run_dir, "reference.json")
+        if not os.path.isdir(os.path.dirname(os.path.abspath(out))):
+            raise EvaluationError(f"--out {out}: its directory does not exist")
+        result = evaluate(a.run_dir, a.episodes, a.seed, a.step)
+    except (EvaluationError, InvalidConfig, CheckpointError) as err:
+        print(f"{p.prog}: error: {err}", file=sys.stderr)
+        return 2
+    print(f"{a.run_dir} ({result['algo']} on {result['task']}, iteration {result['step']}), "
+          f"{a.episodes} episodes each:")  # fmt: skip
+    print(_line("ours (MJX)", result["ours"]))
+    print(_line(result["reference"], result["fetch"]))
+    if a.traces:
+        cfg, env, trainer, pstate, _ = load_run(a.run_dir, a.step)
+        act = policy_act(trainer, pstate)
+        tr = traces(env, cfg.env, lambda o, g: trainer.policy.act(pstate, o, g), act, a.episodes, a.seed)
+        resp = step_response(env, cfg.env, (1.0, 0.0, 0.0, 0.0))
+        np.savez_compressed(a.traces, **tr, response_fetch=resp["fetch_step"], response_ours=resp["ours_step"])
+        result["traces"] = {"file": a.traces, "ours": split_by_final(tr, "ours"), "fetch": split_by_final(tr, "fetch")}
+        result["step_response"] = resp
+        print(f"traces: {a.traces}")
+    write_json_atomic(out, result)
+    print(f"wrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
