@@ -136,9 +136,8 @@ def reference_id(task: str) -> str:
     return REFERENCE_IDS[task]
 
 
-def make_reference(task: str):
-    """The ``Fetch*-v4`` env matching our ``task``, with the run-time fix applied where needed."""
-    env_id = reference_id(task)
+def import_reference():
+    """gymnasium, its Fetch envs registered and the run-time fix applied where needed."""
     try:
         import gymnasium as gym
         import gymnasium_robotics
@@ -146,7 +145,13 @@ def make_reference(task: str):
         raise EvaluationError(f"the reference simulator is not installed: {EXTRA}") from None
     fix_joint_type_asserts()
     gym.register_envs(gymnasium_robotics)
-    return gym.make(env_id)
+    return gym
+
+
+def make_reference(task: str):
+    """The ``Fetch*-v4`` env matching our ``task``."""
+    env_id = reference_id(task)
+    return import_reference().make(env_id)
 
 
 def reference_start(env, home_shift: np.ndarray, object_xy: np.ndarray | None, goal: np.ndarray,
@@ -288,7 +293,8 @@ def wilson(successes: int, n: int, z: float = Z95) -> tuple[float, float]:
     p = successes / n
     centre = (p + z * z / (2 * n)) / (1 + z * z / n)
     half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return (max(0.0, centre - half), min(1.0, centre + half))
+    lo = 0.0 if successes == 0 else max(0.0, centre - half)
+    return (lo, 1.0 if successes == n else min(1.0, centre + half))
 
 
 def summarise(any_step, final_step, distance) -> dict:
@@ -339,8 +345,8 @@ def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None 
 
     from splid_jax.rollout import rollout
 
+    import_reference()  # a missing extra fails before any work
     cfg, env, trainer, pstate, step = load_run(run_dir, step)
-    make_reference(cfg.env).close()  # a missing extra fails before any work
     states = jax.jit(lambda ps, k: rollout(env, trainer, ps, k, episodes))(pstate, jax.random.PRNGKey(seed))
     succ = np.asarray(states.success[1:] & ~states.invalid[1:])
     dist = np.linalg.norm(np.asarray(states.achieved_goal[-1] - states.desired_goal[-1]), axis=-1)
@@ -488,6 +494,8 @@ def main(argv: list[str] | None = None) -> int:
             raise EvaluationError("pass --reference (the evaluation in our task alone is what train reports)")
         if a.episodes < 1:
             raise EvaluationError(f"--episodes {a.episodes}: must be >= 1")
+        if not os.path.isdir(a.run_dir):
+            raise EvaluationError(f"{a.run_dir} is not a directory")
         out = a.out or os.path.join(a.run_dir, "reference.json")
         if not os.path.isdir(os.path.dirname(os.path.abspath(out))):
             raise EvaluationError(f"--out {out}: its directory does not exist")
