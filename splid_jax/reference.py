@@ -140,7 +140,9 @@ def import_reference():
     """gymnasium, its Fetch envs registered and the run-time fix applied where needed."""
     try:
         import gymnasium as gym
-        import gymnasium_robotics
+
+        with contextlib.redirect_stderr(io.StringIO()):  # a notice about its Adroit envs on import
+            import gymnasium_robotics
     except ImportError:
         raise EvaluationError(f"the reference simulator is not installed: {EXTRA}") from None
     fix_joint_type_asserts()
@@ -420,30 +422,47 @@ def split_by_final(tr: dict, sim: str) -> dict:
     return out
 
 
-def step_response(task_env, task: str, action, hold: int = 10, release: int = 10) -> dict:
-    """The grip position's response in both simulators to ``action`` held ``hold`` steps then zero for
-    ``release`` steps, from each one's home: per-step displacement (m) along each axis."""
+def grip_paths(task_env, task: str, actions) -> tuple[np.ndarray, np.ndarray]:
+    """Grip positions [T + 1, 3] of (ours, reference) under the same ``actions`` [T, 4] from each
+    one's home (our ``reset(PRNGKey(0))``, the reference's ``reset(seed=0)``)."""
     import jax
     import jax.numpy as jnp
 
-    seq = np.concatenate([np.tile(np.asarray(action, np.float64), (hold, 1)), np.zeros((release, 4))])
     env = make_reference(task)
     o, _ = env.reset(seed=0)
-    grip = [o["observation"][:3]]
-    for a in seq:
-        o, *_ = env.step(a)
-        grip.append(o["observation"][:3])
+    ref = [o["observation"][:3]]
+    for a in actions:
+        o, *_ = env.step(np.asarray(a, np.float64))
+        ref.append(o["observation"][:3])
     env.close()
     s = task_env.reset(jax.random.PRNGKey(0))
     step = jax.jit(task_env.step)
     ours = [np.asarray(s.obs[:3])]
-    for a in seq:
+    for a in actions:
         s = step(s, jnp.asarray(a, jnp.float32))
         ours.append(np.asarray(s.obs[:3]))
-    ref_disp, our_disp = np.diff(np.array(grip), axis=0), np.diff(np.array(ours), axis=0)
-    return {"action": list(map(float, action)), "hold": hold, "release": release,
-            "fetch_step": ref_disp.tolist(), "ours_step": our_disp.tolist(),
-            "commanded_per_step": (0.05 * np.asarray(action[:3])).tolist()}  # fmt: skip
+    return np.array(ours, np.float64), np.array(ref, np.float64)
+
+
+def step_response(task_env, task: str, action=(1.0, 0.0, 0.0, 0.0), hold: int = 10, release: int = 10) -> dict:
+    """The grip's per-step displacement (m) in both simulators under ``action`` held ``hold`` steps then
+    zero for ``release`` steps, and under zero action alone from home (drift at rest)."""
+    held = np.concatenate([np.tile(np.asarray(action, np.float64), (hold, 1)), np.zeros((release, 4))])
+    ours, ref = grip_paths(task_env, task, held)
+    ours_rest, ref_rest = grip_paths(task_env, task, np.zeros((hold + release, 4)))
+    return {
+        "action": [float(x) for x in action],
+        "hold": hold,
+        "release": release,
+        "commanded_per_step": (0.05 * np.asarray(action[:3], np.float64)).tolist(),
+        "ours_step": np.diff(ours, axis=0).tolist(),
+        "fetch_step": np.diff(ref, axis=0).tolist(),
+        "ours_rest_step": np.diff(ours_rest, axis=0).tolist(),
+        "fetch_rest_step": np.diff(ref_rest, axis=0).tolist(),
+    }
+
+
+RESPONSE_KEYS = ("ours_step", "fetch_step", "ours_rest_step", "fetch_rest_step")
 
 
 # ---- command line -------------------------------------------------------------------------------------
@@ -471,17 +490,40 @@ def build_parser() -> argparse.ArgumentParser:
         "Fetch*-v4) and in our task, with 95 %% intervals.",
         allow_abbrev=False,
     )
-    p.add_argument("run_dir", metavar="RUN_DIR")
+    p.add_argument("run_dir", metavar="RUN_DIR", nargs="?", default=None)
+    p.add_argument("--scripted", metavar="TASK", choices=sorted(REFERENCE_IDS), default=None,
+                   help="instead of a run, the task's scripted controller (envs/fetch/scripted.py), from the same "
+                   "starts and goals in both simulators: a check of the observation mapping")  # fmt: skip
     p.add_argument("--reference", action="store_true", help="run the policy in the matching Fetch*-v4 (needs "
                    f"{EXTRA})")  # fmt: skip
     p.add_argument("--episodes", type=int, default=300, help="episodes in each simulator (default: 300)")
     p.add_argument("--seed", type=int, default=0, help="seed of the episodes' starts and goals (default: 0)")
     p.add_argument("--step", type=int, default=None, help="checkpoint (iteration) to load (default: the newest)")
-    p.add_argument("--out", default=None, metavar="FILE.json", help="default: RUN_DIR/reference.json")
+    p.add_argument("--out", default=None, metavar="FILE.json",
+                   help="default: RUN_DIR/reference.json (with --scripted: scripted-TASK.json)")  # fmt: skip
     p.add_argument("--traces", default=None, metavar="FILE.npz",
                    help="also trace both simulators from the same starts and goals (distance to goal, object "
                    "speed, grip position per step) and the grip's response to a held action")  # fmt: skip
     return p
+
+
+def scripted(task: str, episodes: int, seed: int) -> tuple[dict, dict]:
+    """The scripted controller of ``task`` from the same starts and goals in both simulators:
+    (result, traces)."""
+    import jax
+
+    from envs.fetch.scripted import CONTROLLERS
+    from splid_jax.loop import make_env
+
+    import_reference()
+    env = make_env(task)
+    act = CONTROLLERS[task]
+    tr = traces(env, task, act, jax.jit(act), episodes, seed)
+    result = {"scripted": task, "task": task, "reference": REFERENCE_IDS[task], "seed": seed}
+    for sim in ("ours", "fetch"):
+        succ, dist = tr[f"{sim}_success"], tr[f"{sim}_distance"][:, -1]
+        result[sim] = summarise(succ.any(axis=1), succ[:, -1], dist)
+    return result, tr
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -492,30 +534,40 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if not a.reference:
             raise EvaluationError("pass --reference (the evaluation in our task alone is what train reports)")
+        if (a.run_dir is None) == (a.scripted is None):
+            raise EvaluationError("give either RUN_DIR or --scripted TASK")
         if a.episodes < 1:
             raise EvaluationError(f"--episodes {a.episodes}: must be >= 1")
-        if not os.path.isdir(a.run_dir):
+        if a.run_dir is not None and not os.path.isdir(a.run_dir):
             raise EvaluationError(f"{a.run_dir} is not a directory")
-        out = a.out or os.path.join(a.run_dir, "reference.json")
+        out = a.out or (os.path.join(a.run_dir, "reference.json") if a.run_dir else f"scripted-{a.scripted}.json")
         if not os.path.isdir(os.path.dirname(os.path.abspath(out))):
             raise EvaluationError(f"--out {out}: its directory does not exist")
-        result = evaluate(a.run_dir, a.episodes, a.seed, a.step)
+        if a.scripted:
+            result, tr = scripted(a.scripted, a.episodes, a.seed)
+            title = f"the scripted {a.scripted} controller, the same {a.episodes} starts in each"
+        else:
+            result = evaluate(a.run_dir, a.episodes, a.seed, a.step)
+            what = f"{result['algo']} on {result['task']}, iteration {result['step']}"
+            title = f"{a.run_dir} ({what}), {a.episodes} episodes each"
+            if a.traces:
+                cfg, env, trainer, pstate, _ = load_run(a.run_dir, a.step)
+                pol = lambda o, g: trainer.policy.act(pstate, o, g)  # noqa: E731
+                tr = traces(env, cfg.env, pol, policy_act(trainer, pstate), a.episodes, a.seed)
     except (EvaluationError, InvalidConfig, CheckpointError) as err:
         print(f"{p.prog}: error: {err}", file=sys.stderr)
         return 2
-    print(f"{a.run_dir} ({result['algo']} on {result['task']}, iteration {result['step']}), "
-          f"{a.episodes} episodes each:")  # fmt: skip
+    print(title + ":")
     print(_line("ours (MJX)", result["ours"]))
     print(_line(result["reference"], result["fetch"]))
     if a.traces:
-        cfg, env, trainer, pstate, _ = load_run(a.run_dir, a.step)
-        act = policy_act(trainer, pstate)
-        tr = traces(env, cfg.env, lambda o, g: trainer.policy.act(pstate, o, g), act, a.episodes, a.seed)
-        resp = step_response(env, cfg.env, (1.0, 0.0, 0.0, 0.0))
-        np.savez_compressed(a.traces, **tr, response_fetch=resp["fetch_step"], response_ours=resp["ours_step"])
+        from splid_jax.loop import make_env
+
+        resp = step_response(make_env(result["task"]), result["task"])
+        np.savez_compressed(a.traces, **tr, **{f"response_{k}": np.asarray(resp[k]) for k in RESPONSE_KEYS})
         result["traces"] = {"file": a.traces, "ours": split_by_final(tr, "ours"), "fetch": split_by_final(tr, "fetch")}
         result["step_response"] = resp
-        print(f"traces: {a.traces}")
+        print(f"traces: {a.traces} (same starts and goals in both; by final-step outcome in the JSON)")
     write_json_atomic(out, result)
     print(f"wrote {out}")
     return 0

@@ -152,7 +152,7 @@ def test_evaluator_on_reach_writes_both_simulators_numbers_and_traces(tmp_path, 
     tr = np.load(tmp_path / "t.npz")
     assert tr["ours_distance"].shape == tr["fetch_distance"].shape == (3, 51)
     np.testing.assert_allclose(tr["ours_distance"][:, 0], tr["fetch_distance"][:, 0], atol=2e-3)  # same starts
-    assert tr["response_fetch"].shape == tr["response_ours"].shape == (20, 3)
+    assert tr["response_fetch_step"].shape == tr["response_ours_rest_step"].shape == (20, 3)
 
 
 @pytest.mark.slow
