@@ -29,8 +29,26 @@ start: the object's x-y (its height and orientation stay the reference's resting
 both moved by the difference of the two simulators' gripper homes (and, in z, object rest heights);
 the gripper starts at each simulator's home.
 
-Differences measured (the traces from the same starts; numbers in ``BENCHMARKS.md``):
-DIFFERENCES
+Differences measured here (traces from the same starts, ``--traces``; ``experiments/reference/RESULTS.md``):
+
+- Every slot has the same meaning, frame (world coordinates, same table and homes within 0.4 mm) and
+  unit in both: the scripted Push controller, fed each simulator's raw observation, succeeds in 300 of
+  300 matched episodes in each (median final distance 0.004 m in both), and Reach's start
+  observations agree within 0.4 mm.
+- Floor: the reference's grip site cannot go below z = 0.418 in Reach (the fingers rest on the
+  table); ours goes down to 0.408. Reach goals below 0.42 (about 11 %) are held at the final step
+  far less often in the reference, where the gripper pressed on the table also drifts 1 to 6 cm in
+  x-y over the last 25 steps: the main cause of Reach's final-step loss.
+- Response to an action (``step_response``): a held a = 1 moves the grip 30 mm in the first step
+  and 33.1 mm per step after (ours 30 and 33.9; commanded 50); on release it goes on 2.3 mm then
+  back 0.3 mm (ours 3.7 and 0.4). Push's first step from home is 26 mm in the reference (its arm is
+  still settling after reset: grip velocity -0.003 m per step in x in the first observation, ours 0).
+- Beyond the arm's reach (a target about 0.2 m or more ahead of home in x) the reference arm creeps
+  back some 7 cm in the 15 steps after release; ours keeps targets within the arm's reach and holds.
+- At rest after reset the reference grip moves 2 to 3 mm in z over the first steps; ours does not.
+  The locked fingers read 0.0004 to 0.0012 in slots [9:11] at the reference's start; ours read 0.
+- The cube turns more about z in the reference under the same scripted pushes (mean |yaw|, slot
+  13: 0.17 rad against 0.09).
 """
 
 from __future__ import annotations
@@ -512,9 +530,9 @@ def scripted(task: str, episodes: int, seed: int) -> tuple[dict, dict]:
     (result, traces)."""
     import jax
 
-    from envs.fetch.scripted import CONTROLLERS
-    from splid_jax.loop import make_env
-
+    with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
+        from envs.fetch.scripted import CONTROLLERS
+        from splid_jax.loop import make_env
     import_reference()
     env = make_env(task)
     act = CONTROLLERS[task]
