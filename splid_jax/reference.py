@@ -330,22 +330,58 @@ def summarise(any_step, final_step, distance) -> dict:
 
 
 # ---- a run's policy -----------------------------------------------------------------------------------
-def load_run(run_dir: str, step: int | None = None):
-    """(config, our task, algorithm, the policy's ``PolicyState``, step) of the run in ``run_dir``."""
+def sweep_member(run_dir: str) -> tuple[str, int, int] | None:
+    """(sweep directory, member index, members) when ``run_dir`` is a member of a sweep, whose
+    checkpoints the sweep directory holds, stacked over members."""
+    parent = os.path.dirname(os.path.abspath(run_dir))
+    path = os.path.join(parent, "sweep.json")
+    if not os.path.isfile(path):
+        return None
+    with open(path) as fh:
+        names = [m.get("run_dir") for m in json.load(fh).get("members", [])]
+    name = os.path.basename(os.path.abspath(run_dir))
+    return (parent, names.index(name), len(names)) if name in names else None
+
+
+def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
+    """A sweep member's task, algorithm, state and step, sliced out of the sweep's stacked checkpoint
+    (laid out as the sweep's own config builds it; members differ only in data, not in shapes)."""
+    import jax
+
     from splid_jax import checkpoint
+    from splid_jax.config import TrainConfig
+    from splid_jax.loop import make_algorithm, make_env
+
+    directory, index, members = sweep
+    with open(os.path.join(directory, "sweep.json")) as fh:
+        cfg = TrainConfig.from_json(json.load(fh)["config"], run_dir=directory)
+    env = make_env(cfg.env, **cfg.env_overrides())
+    trainer = make_algorithm(cfg, env)
+    like = jax.eval_shape(jax.vmap(trainer.init), jax.random.split(jax.random.PRNGKey(0), members))
+    step, state, _ = checkpoint.restore(directory, like, step=step)
+    return env, trainer, jax.tree.map(lambda x: x[index], state), step
+
+
+def load_run(run_dir: str, step: int | None = None):
+    """(config, our task, algorithm, the policy's ``PolicyState``, step) of the run in ``run_dir``: a
+    run of train, or a member of a sweep."""
+    from splid_jax import checkpoint
+    from splid_jax.networks import PolicyState
     from splid_jax.rollout import load_config, load_policy
 
     if not os.path.isdir(run_dir):
         raise EvaluationError(f"{run_dir} is not a directory")
     cfg = load_config(run_dir)
     reference_id(cfg.env)
-    if checkpoint.latest_step(run_dir) is None:
+    sweep = sweep_member(run_dir) if checkpoint.latest_step(run_dir) is None else None
+    if checkpoint.latest_step(run_dir) is None and (sweep is None or checkpoint.latest_step(sweep[0]) is None):
         raise EvaluationError(f"{run_dir} holds no checkpoint (train writes them in {run_dir}/checkpoints)")
     with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
-        env, trainer, state, step = load_policy(cfg, step)
+        if sweep is None:
+            env, trainer, state, step = load_policy(cfg, step)
+        else:
+            env, trainer, state, step = _restore_member(cfg, sweep, step)
     pstate = getattr(state, "policy", None)
-    from splid_jax.networks import PolicyState
-
     if not isinstance(pstate, PolicyState):
         raise EvaluationError(f"the checkpoint of {run_dir} holds no policy (no networks.PolicyState at .policy)")
     return cfg, env, trainer, pstate, step
