@@ -174,11 +174,10 @@ def make_reference(task: str):
     return import_reference().make(env_id)
 
 
-def reference_start(env, home_shift: np.ndarray, object_xy: np.ndarray | None, goal: np.ndarray,
-                    rest_shift: float = 0.0) -> dict:  # fmt: skip
-    """Put the reference env (already ``reset``) at our start: object x-y and goal, moved by
-    ``home_shift`` (reference grip home - ours) and, for goals on the table, ``rest_shift`` in z
-    (reference object rest height - ours). Returns its observation dict."""
+def reference_start(env, object_xy: np.ndarray | None, goal: np.ndarray) -> dict:
+    """Put the reference env (already ``reset``) at a start given in its own coordinates: the object's
+    x-y (its height, orientation and the gripper stay as its reset left them) and the goal. Returns
+    its observation dict."""
     import mujoco
 
     u = env.unwrapped
@@ -186,10 +185,10 @@ def reference_start(env, home_shift: np.ndarray, object_xy: np.ndarray | None, g
         from gymnasium_robotics.utils import mujoco_utils
 
         q = mujoco_utils.get_joint_qpos(u.model, u.data, "object0:joint")
-        q[:2] = np.asarray(object_xy, np.float64) + home_shift[:2]
+        q[:2] = object_xy
         mujoco_utils.set_joint_qpos(u.model, u.data, "object0:joint", q)
         mujoco_utils.set_joint_qvel(u.model, u.data, "object0:joint", np.zeros(6))
-    u.goal = np.asarray(goal, np.float64) + home_shift + np.array([0.0, 0.0, rest_shift])
+    u.goal = np.asarray(goal, np.float64).copy()
     mujoco.mj_forward(u.model, u.data)
     return u._get_obs()
 
@@ -230,7 +229,7 @@ def run_reference(task: str, act, episodes: int, seed: int, starts: dict | None 
             if starts is not None:
                 i = first + j
                 xy = None if starts["object_xy"] is None else starts["object_xy"][i]
-                o = reference_start(env, starts["home_shift"], xy, starts["goal"][i], starts["rest_shift"][i])
+                o = reference_start(env, xy, starts["goal"][i])
             dicts.append(o)
         obs = [np.stack([d["observation"] for d in dicts])]
         ach = [np.stack([d["achieved_goal"] for d in dicts])]
@@ -258,21 +257,23 @@ def run_reference(task: str, act, episodes: int, seed: int, starts: dict | None 
 # ---- our task ----------------------------------------------------------------------------------------
 def our_starts(env, key, episodes: int, reference_env=None):
     """Our task's starts (``jax.vmap(env.reset)`` of ``episodes`` keys split from ``key``, as the
-    project's evaluation draws them) and, given a reset reference env, what ``reference_start`` needs."""
+    project's evaluation draws them): ``state``, and the object x-y and goal for ``reference_start``.
+    Given a reset reference env, these are moved into its coordinates: x-y by the difference of the two
+    grip homes; z by that of the object rest heights (tasks with an object: goals sit on the table or a
+    lift above it) or of the grip homes (Reach)."""
     import jax
 
     start = jax.vmap(env.reset)(jax.random.split(key, episodes))
-    starts = {"state": start, "goal": np.asarray(start.desired_goal, np.float64)}
-    lay = env.layout
-    starts["object_xy"] = np.asarray(start.achieved_goal[:, :2], np.float64) if env.has_object else None
+    goal = np.asarray(start.desired_goal, np.float64)
+    xy = np.asarray(start.achieved_goal[:, :2], np.float64) if env.has_object else None
     if reference_env is not None:
-        u = reference_env.unwrapped
-        starts["home_shift"] = np.asarray(u.initial_gripper_xpos[:3], np.float64) - np.asarray(lay.grip_home)
-        shift = float(u.height_offset) - lay.object_rest_z if env.has_object else 0.0
-        # goals resting on the table move by the rest-height difference, goals in the air by the homes'
-        on_table = np.isclose(starts["goal"][:, 2], lay.object_rest_z) if env.has_object else np.zeros(episodes, bool)
-        starts["rest_shift"] = np.where(on_table, shift - starts["home_shift"][2], 0.0)
-    return starts
+        u, lay = reference_env.unwrapped, env.layout
+        shift = np.asarray(u.initial_gripper_xpos[:3], np.float64) - np.asarray(lay.grip_home)
+        if env.has_object:
+            shift[2] = float(u.height_offset) - lay.object_rest_z
+            xy = xy + shift[:2]
+        goal = goal + shift
+    return {"state": start, "object_xy": xy, "goal": goal}
 
 
 def run_ours(env, act, start) -> Episodes:
