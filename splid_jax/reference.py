@@ -433,6 +433,29 @@ def trace_arrays(ep: Episodes, has_object: bool) -> dict:
     return {"distance": dist, "object_speed": speed, "grip": grip, "success": ep.success}
 
 
+SLOTS = {
+    25: ("grip x", "grip y", "grip z", "object x", "object y", "object z", "rel x", "rel y", "rel z",
+         "finger l", "finger r", "euler a", "euler b", "euler c", "rel vel x", "rel vel y", "rel vel z",
+         "ang vel x", "ang vel y", "ang vel z", "grip vel x", "grip vel y", "grip vel z", "finger vel l",
+         "finger vel r"),
+    10: ("grip x", "grip y", "grip z", "finger l", "finger r", "grip vel x", "grip vel y", "grip vel z",
+         "finger vel l", "finger vel r"),
+}  # fmt: skip
+
+
+def compare_slots(ours_obs: np.ndarray, fetch_obs: np.ndarray) -> dict:
+    """Per observation slot, over every step of matched episodes ([E, T + 1, O] each): mean |value| in
+    each simulator, mean |difference|, and the largest difference at the start (where both should agree)."""
+    mean_abs = lambda x: np.abs(x).mean(axis=(0, 1))  # noqa: E731
+    cols = (mean_abs(ours_obs), mean_abs(fetch_obs), mean_abs(ours_obs - fetch_obs),
+            np.abs(ours_obs[:, 0] - fetch_obs[:, 0]).max(axis=0))  # fmt: skip
+    keys = ("ours", "fetch", "diff", "start_diff")
+    return {
+        name: {k: float(c[i]) for k, c in zip(keys, cols, strict=True)}
+        for i, name in enumerate(SLOTS[ours_obs.shape[-1]])
+    }
+
+
 def matched_episodes(task_env, task: str, act_jax, act_np, episodes: int, seed: int):
     """(ours, reference) ``Episodes`` from the same starts and goals: our task's ``reset`` draws
     them, the reference is put there after its own reset."""
@@ -451,7 +474,7 @@ def traces(task_env, task: str, act_jax, act_np, episodes: int, seed: int) -> di
     """Traces of both simulators from the same starts, keys ``ours_*`` and ``fetch_*`` ([E, T + 1]
     or [E, T + 1, 3]; ``*_success`` [E, T]) and the start goals."""
     ours, ref = matched_episodes(task_env, task, act_jax, act_np, episodes, seed)
-    out = {"goal_ours": ours.goal, "goal_fetch": ref.goal}
+    out = {"goal_ours": ours.goal, "goal_fetch": ref.goal, "ours_obs": ours.obs, "fetch_obs": ref.obs}
     for name, ep in (("ours", ours), ("fetch", ref)):
         for k, v in trace_arrays(ep, task_env.has_object).items():
             out[f"{name}_{k}"] = v
@@ -622,6 +645,7 @@ def main(argv: list[str] | None = None) -> int:
         np.savez_compressed(a.traces, **tr, **{f"response_{k}": np.asarray(resp[k]) for k in RESPONSE_KEYS})
         result["traces"] = {"file": a.traces, "ours": split_by_final(tr, "ours"), "fetch": split_by_final(tr, "fetch")}
         result["step_response"] = resp
+        result["slots"] = compare_slots(tr["ours_obs"], tr["fetch_obs"])
         print(f"traces: {a.traces} (same starts and goals in both; by final-step outcome in the JSON)")
     write_json_atomic(out, result)
     print(f"wrote {out}")

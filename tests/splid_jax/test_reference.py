@@ -152,6 +152,8 @@ def test_evaluator_on_reach_writes_both_simulators_numbers_and_traces(tmp_path, 
     tr = np.load(tmp_path / "t.npz")
     assert tr["ours_distance"].shape == tr["fetch_distance"].shape == (3, 51)
     np.testing.assert_allclose(tr["ours_distance"][:, 0], tr["fetch_distance"][:, 0], atol=2e-3)  # same starts
+    assert tr["ours_obs"].shape == tr["fetch_obs"].shape == (3, 51, 10)
+    assert set(got["slots"]) >= {"grip x", "finger vel r"}
     assert tr["response_fetch_step"].shape == tr["response_ours_rest_step"].shape == (20, 3)
 
 
@@ -188,3 +190,13 @@ def test_a_sweep_member_loads_its_slice_of_the_sweep_checkpoint(tmp_path):
     want = jax.tree.leaves(jax.tree.map(lambda x: x[1], stacked.policy.params))
     for got, exp in zip(jax.tree.leaves(pstate.params), want, strict=True):
         np.testing.assert_array_equal(np.asarray(got), np.asarray(exp))
+
+
+def test_compare_slots_names_each_slot():
+    ours = np.zeros((2, 3, 25))
+    fetch = ours.copy()
+    fetch[:, :, 13] = 0.5  # the object's yaw
+    got = reference.compare_slots(ours, fetch)
+    assert list(got)[13] == "euler c" and len(got) == 25
+    assert got["euler c"] == {"ours": 0.0, "fetch": 0.5, "diff": 0.5, "start_diff": 0.5}
+    assert got["grip x"]["diff"] == 0.0
