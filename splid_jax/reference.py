@@ -355,18 +355,18 @@ def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
     from splid_jax.loop import make_algorithm, make_env
 
     directory, index, members = sweep
+    env = make_env(cfg.env, **cfg.env_overrides())  # the member's task, with any changed fields
     with open(os.path.join(directory, "sweep.json")) as fh:
-        cfg = TrainConfig.from_json(json.load(fh)["config"], run_dir=directory)
-    env = make_env(cfg.env, **cfg.env_overrides())
-    trainer = make_algorithm(cfg, env)
+        trainer = make_algorithm(TrainConfig.from_json(json.load(fh)["config"], run_dir=directory), env)
     like = jax.eval_shape(jax.vmap(trainer.init), jax.random.split(jax.random.PRNGKey(0), members))
     step, state, _ = checkpoint.restore(directory, like, step=step)
     return env, trainer, jax.tree.map(lambda x: x[index], state), step
 
 
-def load_run(run_dir: str, step: int | None = None):
+def load_run(run_dir: str, step: int | None = None, env_options: str = ""):
     """(config, our task, algorithm, the policy's ``PolicyState``, step) of the run in ``run_dir``: a
-    run of train, or a member of a sweep."""
+    run of train, or a member of a sweep. ``env_options`` (``KEY=VALUE,...``) change our task's fields
+    from the run's, e.g. ``table=box`` to put the reference's table edges in our task."""
     from splid_jax import checkpoint
     from splid_jax.networks import PolicyState
     from splid_jax.rollout import load_config, load_policy
@@ -374,6 +374,8 @@ def load_run(run_dir: str, step: int | None = None):
     if not os.path.isdir(run_dir):
         raise EvaluationError(f"{run_dir} is not a directory")
     cfg = load_config(run_dir)
+    if env_options:
+        cfg = dataclasses.replace(cfg, env_options=",".join(filter(None, (cfg.env_options, env_options))))
     reference_id(cfg.env)
     sweep = sweep_member(run_dir) if checkpoint.latest_step(run_dir) is None else None
     if checkpoint.latest_step(run_dir) is None and (sweep is None or checkpoint.latest_step(sweep[0]) is None):
@@ -396,7 +398,7 @@ def policy_act(trainer, pstate):
     return jax.jit(lambda o, g: trainer.policy.act(pstate, o, g))
 
 
-def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None = None) -> dict:
+def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None = None, env_options: str = "") -> dict:
     """The run's policy in the reference (its own resets, seeds ``seed`` ...) and in our task (the
     project's evaluation draw: ``rollout.rollout`` from ``PRNGKey(seed)``), ``episodes`` each."""
     import jax
@@ -404,7 +406,7 @@ def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None 
     from splid_jax.rollout import rollout
 
     import_reference()  # a missing extra fails before any work
-    cfg, env, trainer, pstate, step = load_run(run_dir, step)
+    cfg, env, trainer, pstate, step = load_run(run_dir, step, env_options)
     states = jax.jit(lambda ps, k: rollout(env, trainer, ps, k, episodes))(pstate, jax.random.PRNGKey(seed))
     succ = np.asarray(states.success[1:] & ~states.invalid[1:])
     dist = np.linalg.norm(np.asarray(states.achieved_goal[-1] - states.desired_goal[-1]), axis=-1)
@@ -417,6 +419,7 @@ def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None 
         "reference": REFERENCE_IDS[cfg.env],
         "step": int(step),
         "seed": seed,
+        "env_options": cfg.env_options,
         "ours": ours,
         "fetch": ref,
     }
@@ -578,6 +581,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--episodes", type=int, default=300, help="episodes in each simulator (default: 300)")
     p.add_argument("--seed", type=int, default=0, help="seed of the episodes' starts and goals (default: 0)")
     p.add_argument("--step", type=int, default=None, help="checkpoint (iteration) to load (default: the newest)")
+    p.add_argument("--env-options", default="", metavar="KEY=VALUE,...",
+                   help="change our task's fields from the run's for its side of the comparison (e.g. table=box: "
+                   "the reference's table, whose edges a pushed cube can fall off)")  # fmt: skip
     p.add_argument("--out", default=None, metavar="FILE.json",
                    help="default: RUN_DIR/reference.json (with --scripted: scripted-TASK.json)")  # fmt: skip
     p.add_argument("--traces", default=None, metavar="FILE.npz",
@@ -626,11 +632,11 @@ def main(argv: list[str] | None = None) -> int:
             result, tr = scripted(a.scripted, a.episodes, a.seed)
             title = f"the scripted {a.scripted} controller, the same {a.episodes} starts in each"
         else:
-            result = evaluate(a.run_dir, a.episodes, a.seed, a.step)
+            result = evaluate(a.run_dir, a.episodes, a.seed, a.step, a.env_options)
             what = f"{result['algo']} on {result['task']}, iteration {result['step']}"
             title = f"{a.run_dir} ({what}), {a.episodes} episodes each"
             if a.traces:
-                cfg, env, trainer, pstate, _ = load_run(a.run_dir, a.step)
+                cfg, env, trainer, pstate, _ = load_run(a.run_dir, a.step, a.env_options)
                 pol = lambda o, g: trainer.policy.act(pstate, o, g)  # noqa: E731
                 tr = traces(env, cfg.env, pol, policy_act(trainer, pstate), a.episodes, a.seed)
     except (EvaluationError, InvalidConfig, CheckpointError) as err:
