@@ -398,15 +398,17 @@ def policy_act(trainer, pstate):
     return jax.jit(lambda o, g: trainer.policy.act(pstate, o, g))
 
 
-def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None = None, env_options: str = "") -> dict:
+def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None = None, env_options: str = "",
+             loaded: tuple | None = None) -> dict:  # fmt: skip
     """The run's policy in the reference (its own resets, seeds ``seed`` ...) and in our task (the
-    project's evaluation draw: ``rollout.rollout`` from ``PRNGKey(seed)``), ``episodes`` each."""
+    project's evaluation draw: ``rollout.rollout`` from ``PRNGKey(seed)``), ``episodes`` each.
+    ``loaded``: what ``load_run`` gave, to load the checkpoint once."""
     import jax
 
     from splid_jax.rollout import rollout
 
     import_reference()  # a missing extra fails before any work
-    cfg, env, trainer, pstate, step = load_run(run_dir, step, env_options)
+    cfg, env, trainer, pstate, step = loaded or load_run(run_dir, step, env_options)
     states = jax.jit(lambda ps, k: rollout(env, trainer, ps, k, episodes))(pstate, jax.random.PRNGKey(seed))
     succ = np.asarray(states.success[1:] & ~states.invalid[1:])
     dist = np.linalg.norm(np.asarray(states.achieved_goal[-1] - states.desired_goal[-1]), axis=-1)
@@ -632,11 +634,13 @@ def main(argv: list[str] | None = None) -> int:
             result, tr = scripted(a.scripted, a.episodes, a.seed)
             title = f"the scripted {a.scripted} controller, the same {a.episodes} starts in each"
         else:
-            result = evaluate(a.run_dir, a.episodes, a.seed, a.step, a.env_options)
+            import_reference()  # a missing extra fails before the checkpoint is read
+            loaded = load_run(a.run_dir, a.step, a.env_options)
+            result = evaluate(a.run_dir, a.episodes, a.seed, loaded=loaded)
             what = f"{result['algo']} on {result['task']}, iteration {result['step']}"
             title = f"{a.run_dir} ({what}), {a.episodes} episodes each"
             if a.traces:
-                cfg, env, trainer, pstate, _ = load_run(a.run_dir, a.step, a.env_options)
+                cfg, env, trainer, pstate, _ = loaded
                 pol = lambda o, g: trainer.policy.act(pstate, o, g)  # noqa: E731
                 tr = traces(env, cfg.env, pol, policy_act(trainer, pstate), a.episodes, a.seed)
     except (EvaluationError, InvalidConfig, CheckpointError) as err:
