@@ -47,6 +47,9 @@ Differences measured here (traces from the same starts, ``--traces``; ``experime
   back some 7 cm in the 15 steps after release; ours keeps targets within the arm's reach and holds.
 - At rest after reset the reference grip moves 2 to 3 mm in z over the first steps; ours does not.
   The locked fingers read 0.0004 to 0.0012 in slots [9:11] at the reference's start; ours read 0.
+- Our Push table is by default a plane without edges (``table="plane"``); the reference's is a box
+  a cube can be pushed off: a short-trained Push policy ends with the cube off the reference's table
+  in 32 % of 300 matched episodes, never in ours (21 % with ``--env-options table=box``).
 - Under the same scripted pushes (300 matched episodes) the reference's cube turns twice as much
   about z (mean |yaw|, slot 13: 0.13 rad against 0.06) and tilts less (slots 11, 12: 0.002 and 0.004
   rad against 0.008); every other slot's mean magnitude agrees within 21 % (the angular velocities differ most).
