@@ -200,3 +200,15 @@ def test_compare_slots_names_each_slot():
     assert list(got)[13] == "euler c" and len(got) == 25
     assert got["euler c"] == {"ours": 0.0, "fetch": 0.5, "diff": 0.5, "start_diff": 0.5}
     assert got["grip x"]["diff"] == 0.0
+
+
+@pytest.mark.slow
+def test_response_measurements_move_the_gripper_and_the_cube_in_both_simulators():
+    env = make_env("push")
+    resp = reference.step_response(env, "push", hold=2, release=1)
+    assert np.asarray(resp["ours_step"]).shape == np.asarray(resp["fetch_rest_step"]).shape == (3, 3)
+    assert resp["ours_step"][1][0] > 0.02 and resp["fetch_step"][1][0] > 0.02  # a_x = 1: tens of mm per step
+    slide = reference.cube_slide(env, "push", (0.5, 0.0), steps=3)
+    assert slide["ours_travel"] > 0.005 and slide["fetch_travel"] > 0.005
+    push = reference.loaded_push(env, "push", (0.0, 1.0, 0.0, 0.0), hold=3, release=1)
+    assert sum(push["ours_object_step"]) > 0.02 and sum(push["fetch_object_step"]) > 0.02
