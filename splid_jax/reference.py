@@ -35,10 +35,12 @@ Differences measured here (traces from the same starts, ``--traces``; ``experime
   unit in both: the scripted Push controller, fed each simulator's raw observation, succeeds in 300 of
   300 matched episodes in each (median final distance 0.004 m in both), and Reach's start
   observations agree within 0.4 mm.
-- Floor: the reference's grip site cannot go below z = 0.418 in Reach (the fingers rest on the
-  table); ours goes down to 0.408. Reach goals below 0.42 (about 11 %) are held at the final step
-  far less often in the reference, where the gripper pressed on the table also drifts 1 to 6 cm in
-  x-y over the last 25 steps: the main cause of Reach's final-step loss.
+- Floor, the largest difference: the reference's fingers meet the table with the grip site at z =
+  0.417 to 0.420, and a downward command there drags them on it (a_y = 1 moves the grip 33 mm per
+  step, with a_z = -0.3 24 mm, with a_z = -1 16 mm); ours clips the target at a workspace floor of
+  0.408 and slides there freely (34 mm per step in all three). Trained policies press down: Push's
+  strike is slower and its cube settles later in the reference, and Reach's lowest goals (below 0.42,
+  about 11 %) are held at the final step far less often, the pressed gripper drifting 1 to 6 cm.
 - Response to an action (``step_response``): a held a = 1 moves the grip 30 mm in the first step
   and 33.1 mm per step after (ours 30 and 33.9; commanded 50); on release it goes on 2.3 mm then
   back 0.3 mm (ours 3.7 and 0.4). Push's first step from home is 26 mm in the reference (its arm is
