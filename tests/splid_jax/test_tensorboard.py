@@ -1,0 +1,69 @@
+"""The TensorBoard writer: metrics records become scalars against episodes, read back from the event files."""
+
+import glob
+import json
+import struct
+
+import pytest
+
+pytest.importorskip("tensorboardX")
+
+from splid_jax import tensorboard  # noqa: E402
+
+
+def read_scalars(log_dir: str) -> dict[str, list[tuple[int, float]]]:
+    """Every scalar in the event files under ``log_dir``: TFRecord frames (length, crc, event, crc)."""
+    from tensorboardX.proto import event_pb2
+
+    out: dict[str, list[tuple[int, float]]] = {}
+    for path in sorted(glob.glob(f"{log_dir}/events.out.tfevents.*")):
+        data = open(path, "rb").read()
+        pos = 0
+        while pos < len(data):
+            (length,) = struct.unpack("<Q", data[pos : pos + 8])
+            event = event_pb2.Event.FromString(data[pos + 12 : pos + 12 + length])
+            pos += 12 + length + 4
+            for v in event.summary.value:
+                out.setdefault(v.tag, []).append((event.step, v.simple_value))
+    return out
+
+
+RECORDS = [
+    {"iteration": 5, "episodes": 320, "eval_success": 0.5, "eval_success_final": 0.25, "horizon": 8, "flag": True},
+    {"iteration": 10, "episodes": 640, "eval_success": 0.75, "eval_success_final": 0.5, "horizon": 8, "loss": None},
+]
+
+
+def test_writer_writes_scalars_against_episodes(tmp_path):
+    with tensorboard.MetricsWriter(str(tmp_path)) as w:
+        for r in RECORDS:
+            w.write(r)
+    got = read_scalars(str(tmp_path))
+    assert got["eval_success"] == [(320, 0.5), (640, 0.75)]
+    assert got["eval_success_final"] == [(320, 0.25), (640, 0.5)]
+    assert got["iteration"] == [(320, 5.0), (640, 10.0)]
+    assert "episodes" not in got and "flag" not in got and "loss" not in got
+
+
+def test_convert_metrics_jsonl(tmp_path):
+    metrics = tmp_path / "metrics.jsonl"
+    metrics.write_text("".join(json.dumps(r) + "\n" for r in RECORDS) + "\n")
+    assert tensorboard.main([str(metrics), str(tmp_path / "tb")]) == 0
+    assert read_scalars(str(tmp_path / "tb"))["eval_success"] == [(320, 0.5), (640, 0.75)]
+
+
+def test_missing_tensorboardx_is_one_line(monkeypatch, tmp_path, capsys):
+    import builtins
+
+    real = builtins.__import__
+
+    def fake(name, *a, **k):
+        if name.startswith("tensorboardX"):
+            raise ImportError(name)
+        return real(name, *a, **k)
+
+    monkeypatch.setattr(builtins, "__import__", fake)
+    metrics = tmp_path / "metrics.jsonl"
+    metrics.write_text(json.dumps(RECORDS[0]) + "\n")
+    assert tensorboard.main([str(metrics), str(tmp_path / "tb")]) == 2
+    assert "pip install" in capsys.readouterr().err
