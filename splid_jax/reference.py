@@ -72,7 +72,7 @@ import tempfile
 
 import numpy as np
 
-from envs.base import InvalidConfig
+from splid_jax.common.errors import InvalidConfig
 
 REFERENCE_IDS = {
     "reach": "FetchReach-v4",
@@ -356,9 +356,10 @@ def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
     (laid out as the sweep's own config builds it; members differ only in data, not in shapes)."""
     import jax
 
-    from splid_jax import checkpoint
     from splid_jax.config import TrainConfig
-    from splid_jax.loop import make_algorithm, make_env
+    from splid_jax.learners.registry import make_algorithm
+    from splid_jax.runtime import checkpoint
+    from splid_jax.runtime.loop import make_env
 
     directory, index, members = sweep
     env = make_env(cfg.env, **cfg.env_overrides())  # the member's task, with any changed fields
@@ -373,9 +374,9 @@ def load_run(run_dir: str, step: int | None = None, env_options: str = ""):
     """(config, our task, algorithm, the policy's ``PolicyState``, step) of the run in ``run_dir``: a
     run of train, or a member of a sweep. ``env_options`` (``KEY=VALUE,...``) change our task's fields
     from the run's, e.g. ``table=box`` to put the reference's table edges in our task."""
-    from splid_jax import checkpoint
-    from splid_jax.networks import PolicyState
+    from splid_jax.common.networks import PolicyState
     from splid_jax.rollout import load_config, load_policy
+    from splid_jax.runtime import checkpoint
 
     if not os.path.isdir(run_dir):
         raise EvaluationError(f"{run_dir} is not a directory")
@@ -688,7 +689,7 @@ def scripted(task: str, episodes: int, seed: int) -> tuple[dict, dict]:
 
     with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
         from envs.fetch.scripted import CONTROLLERS
-        from splid_jax.loop import make_env
+        from splid_jax.runtime.loop import make_env
     import_reference()
     env = make_env(task)
     act = CONTROLLERS[task]
@@ -701,7 +702,7 @@ def scripted(task: str, episodes: int, seed: int) -> tuple[dict, dict]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from splid_jax.checkpoint import CheckpointError
+    from splid_jax.runtime.checkpoint import CheckpointError
 
     p = build_parser()
     a = p.parse_args(argv)
@@ -737,7 +738,7 @@ def main(argv: list[str] | None = None) -> int:
     print(_line("ours (MJX)", result["ours"]))
     print(_line(result["reference"], result["fetch"]))
     if a.traces:
-        from splid_jax.loop import make_env
+        from splid_jax.runtime.loop import make_env
 
         resp = step_response(make_env(result["task"]), result["task"])
         np.savez_compressed(a.traces, **tr, **{f"response_{k}": np.asarray(resp[k]) for k in RESPONSE_KEYS})

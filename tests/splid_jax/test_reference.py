@@ -12,9 +12,12 @@ import pytest
 pytest.importorskip("gymnasium_robotics")
 
 from envs.fetch import scripted  # noqa: E402
-from splid_jax import checkpoint, reference  # noqa: E402
+from splid_jax import reference  # noqa: E402
 from splid_jax.config import TrainConfig  # noqa: E402
-from splid_jax.loop import env_settings, make_algorithm, make_env  # noqa: E402
+from splid_jax.learners.registry import make_algorithm  # noqa: E402
+from splid_jax.runtime import checkpoint  # noqa: E402
+from splid_jax.runtime.loop import make_env  # noqa: E402
+from splid_jax.runtime.run_files import env_settings  # noqa: E402
 
 
 def fresh_mujoco_utils():
