@@ -38,9 +38,25 @@ from splid_jax.runtime.run_files import MAY_CHANGE_ON_RESUME, env_settings  # no
 __all__ = ["RunStopped", "build_parser", "config_from_cli", "env_settings", "main", "make_env", "run"]
 
 
-def run(cfg: TrainConfig, env: envs.GoalEnv | None = None, resume: bool = False, quiet: bool = False) -> dict:
-    """Train one run to ``cfg.iterations``; returns its last metrics record."""
-    return loop.run(cfg, env, resume=resume, quiet=quiet)[0]
+def run(
+    cfg: TrainConfig,
+    env: envs.GoalEnv | None = None,
+    resume: bool = False,
+    quiet: bool = False,
+    tensorboard: str | None = None,
+) -> dict:
+    """Train one run to ``cfg.iterations``; returns its last metrics record. ``tensorboard``: a
+    directory that also receives every record as TensorBoard scalars."""
+    if not tensorboard:
+        return loop.run(cfg, env, resume=resume, quiet=quiet)[0]
+    from splid_jax.tensorboard import MetricsWriter, TensorBoardUnavailable
+
+    try:
+        writer = MetricsWriter(tensorboard)
+    except TensorBoardUnavailable as err:
+        raise InvalidConfig("tensorboard", tensorboard, f"a directory, with {err}") from None
+    with writer:
+        return loop.run(cfg, env, resume=resume, quiet=quiet, on_record=lambda _, rec: writer.write(rec))[0]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -54,6 +70,12 @@ def build_parser() -> argparse.ArgumentParser:
     add_config_flags(parser, TrainConfig, TASK_DEFAULTS, per_algo=registry.task_defaults())
     parser.add_argument("--resume", metavar="RUN_DIR", help="continue the run saved in RUN_DIR (its config.json)")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
+    parser.add_argument(
+        "--tensorboard",
+        metavar="DIR",
+        help="also write every evaluation's metrics as TensorBoard scalars under DIR, against episodes "
+        '(needs pip install -e ".[tensorboard]")',
+    )
     add_compile_cache_flag(parser)
     add_launch_flags(parser)
     return parser
@@ -92,7 +114,7 @@ def main(argv: list[str] | None = None) -> int:
         cfg, resume = multihost.from_first(lambda: config_from_cli(ns))  # its --resume directory: process 0's
         env = make_env(cfg.env, **cfg.env_overrides())
         cfg.check_env(env)
-        rec = run(cfg, env, resume=resume, quiet=ns.quiet)
+        rec = run(cfg, env, resume=resume, quiet=ns.quiet, tensorboard=ns.tensorboard)
     except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 2

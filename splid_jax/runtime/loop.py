@@ -19,7 +19,7 @@ import json
 import os
 import signal
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import jax
@@ -126,8 +126,12 @@ def run(
     members: Sequence[TrainConfig] | None = None,
     resume: bool = False,
     quiet: bool = False,
+    on_record: Callable[[str, dict], None] | None = None,
 ) -> list[dict]:
     """Train to ``cfg.iterations``; returns the last metrics record of each lane (one for a run).
+
+    ``on_record(run_dir, record)`` sees every record as it is written to its lane's metrics.jsonl
+    (a TensorBoard writer, say).
 
     ``members``: the configs of a sweep's members (each its own seed, run_dir and traced settings),
     trained in lock-step as one vmapped program with checkpoints under ``cfg.run_dir``. Over several
@@ -137,12 +141,14 @@ def run(
     split_envs = place.axis == devices.ENVS and place.count > 1
     algo = algo or registry.make_algorithm(cfg, env, place.mesh if split_envs else None)
     with Signals() as signals:
-        return _Loop(cfg, env, algo, members, place, signals, quiet).run(resume)
+        return _Loop(cfg, env, algo, members, place, signals, quiet, on_record).run(resume)
 
 
 class _Loop:
-    def __init__(self, cfg, env, algo, members, place: devices.Placement, signals: Signals, quiet: bool):
+    def __init__(self, cfg, env, algo, members, place: devices.Placement, signals: Signals, quiet: bool,
+                 on_record: Callable[[str, dict], None] | None = None):  # fmt: skip
         self.cfg, self.env, self.algo, self.signals = cfg, env, algo, signals
+        self.on_record = on_record
         self.writes = multihost.is_first()  # the others compute their share and leave the run directory alone
         self.quiet = quiet or not self.writes
         self.stacked = members is not None
@@ -312,6 +318,8 @@ class _Loop:
                 for lane, rec in zip(lanes, last, strict=True) if self.writes else ():  # past a checkpoint: dropped
                     with open(os.path.join(lane.run_dir, METRICS), "a") as fh:
                         fh.write(json.dumps(rec) + "\n")
+                    if self.on_record is not None:
+                        self.on_record(lane.run_dir, rec)
                 state, iteration, select_steps, chunks = new_state, done, totals, chunks + 1
                 if self.stacked:
                     self.show(progress.sweep_line(last, cfg.iterations))

@@ -67,3 +67,16 @@ def test_missing_tensorboardx_is_one_line(monkeypatch, tmp_path, capsys):
     metrics.write_text(json.dumps(RECORDS[0]) + "\n")
     assert tensorboard.main([str(metrics), str(tmp_path / "tb")]) == 2
     assert "pip install" in capsys.readouterr().err
+
+
+def test_train_writes_every_record_to_tensorboard(tmp_path):
+    from splid_jax import train
+
+    run_dir, log_dir = tmp_path / "run", tmp_path / "tb"
+    argv = ["--env", "point", "--iterations", "10", "--num-envs", "8", "--eval-episodes", "8", "--bc-steps", "5"]
+    argv += ["--run-dir", str(run_dir), "--quiet", "--compile-cache", "", "--tensorboard", str(log_dir)]
+    assert train.main(argv) == 0
+    records = [json.loads(line) for line in (run_dir / "metrics.jsonl").read_text().splitlines()]
+    seen = read_scalars(str(log_dir))
+    assert [step for step, _ in seen["eval_success_final"]] == [r["episodes"] for r in records]
+    assert [v for _, v in seen["eval_success"]] == pytest.approx([r["eval_success"] for r in records])
