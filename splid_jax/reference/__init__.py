@@ -58,7 +58,7 @@ Differences measured here (traces from the same starts, ``--traces``; ``experime
 
 The modules, one job each: ``extra`` (the optional extra's import, the ``Fetch*-v4`` of each task and
 the run-time fix), ``mapping`` (matched starts), ``episodes`` (running both simulators, Wilson
-intervals), ``traces`` (traces from the same starts, slots compared), ``response`` (the physical-response
+intervals), ``tracing`` (traces from the same starts, slots compared), ``response`` (the physical-response
 measurements), ``policy`` (a run's policy, sweep members included) and ``cli``. Their public names are
 reachable from this package too, loaded on first use.
 """
@@ -89,7 +89,7 @@ _HOMES = {
         "summarise",
         "wilson",
     ),
-    "splid_jax.reference.traces": ("SLOTS", "compare_slots", "split_by_final", "trace_arrays", "traces"),
+    "splid_jax.reference.tracing": ("SLOTS", "compare_slots", "split_by_final", "trace_arrays", "traces"),
     "splid_jax.reference.response": (
         "RESPONSE_KEYS",
         "cube_slide",

@@ -18,7 +18,7 @@ from splid_jax.reference.episodes import summarise
 from splid_jax.reference.extra import EXTRA, REFERENCE_IDS, EvaluationError, import_reference
 from splid_jax.reference.policy import evaluate, load_run, policy_act
 from splid_jax.reference.response import RESPONSE_KEYS, step_response
-from splid_jax.reference.traces import compare_slots, split_by_final, traces
+from splid_jax.reference.tracing import compare_slots, split_by_final, traces
 
 
 def write_json_atomic(path: str, obj) -> None:
