@@ -6,7 +6,7 @@ from splid_jax.cli import exit_with, quiet_interrupts
 if __name__ == "__main__":  # a signal while JAX loads ends the process with one line, no traceback
     quiet_interrupts()
 
-from splid_jax.reference import main  # noqa: E402
+from splid_jax.reference.cli import main  # noqa: E402
 
 if __name__ == "__main__":
     exit_with(main())

@@ -4,7 +4,7 @@ at or below ``FLOOR``: whether pressing the gripper on the table is what loses t
     python experiments/reference/no_press.py RUN_DIR [FLOOR] [--only]
 
 ``--only`` skips the unchanged policy. 300 episodes from the reference's own resets (seeds 0 to 299),
-as ``python -m splid_jax.reference RUN_DIR --reference`` runs them.
+as ``python -m splid_jax.evaluate RUN_DIR --reference`` runs them.
 """
 
 from __future__ import annotations

@@ -1,0 +1,134 @@
+"""``python -m splid_jax.evaluate RUN_DIR --reference`` (or ``--scripted TASK``): the command line,
+its one-line errors (exit code 2) and the JSON it writes."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import json
+import os
+import sys
+import tempfile
+
+import numpy as np
+
+from splid_jax.common.errors import InvalidConfig
+from splid_jax.reference.episodes import summarise
+from splid_jax.reference.extra import EXTRA, REFERENCE_IDS, EvaluationError, import_reference
+from splid_jax.reference.policy import evaluate, load_run, policy_act
+from splid_jax.reference.response import RESPONSE_KEYS, step_response
+from splid_jax.reference.tracing import compare_slots, split_by_final, traces
+
+
+def write_json_atomic(path: str, obj) -> None:
+    folder = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".reference-", suffix=".json")
+    with os.fdopen(fd, "w") as fh:
+        json.dump(obj, fh, indent=1)
+    os.replace(tmp, path)
+
+
+def _line(name: str, s: dict) -> str:
+    lo_a, hi_a = s["success_any_ci95"]
+    lo_f, hi_f = s["success_final_ci95"]
+    return (
+        f"{name:22s} any {s['success_any']:.3f} [{lo_a:.3f}, {hi_a:.3f}]  final {s['success_final']:.3f} "
+        f"[{lo_f:.3f}, {hi_f:.3f}]  median final distance {s['median_final_distance']:.3f} m"
+    )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python -m splid_jax.evaluate",
+        description="Evaluate a run's deterministic policy in the reference simulator (Gymnasium-Robotics "
+        "Fetch*-v4) and in our task, with 95 %% intervals.",
+        allow_abbrev=False,
+    )
+    p.add_argument("run_dir", metavar="RUN_DIR", nargs="?", default=None)
+    p.add_argument("--scripted", metavar="TASK", choices=sorted(REFERENCE_IDS), default=None,
+                   help="instead of a run, the task's scripted controller (envs/fetch/scripted.py), from the same "
+                   "starts and goals in both simulators: a check of the observation mapping")  # fmt: skip
+    p.add_argument("--reference", action="store_true", help="run the policy in the matching Fetch*-v4 (needs "
+                   f"{EXTRA})")  # fmt: skip
+    p.add_argument("--episodes", type=int, default=300, help="episodes in each simulator (default: 300)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the episodes' starts and goals (default: 0)")
+    p.add_argument("--step", type=int, default=None, help="checkpoint (iteration) to load (default: the newest)")
+    p.add_argument("--env-options", default="", metavar="KEY=VALUE,...",
+                   help="change our task's fields from the run's for its side of the comparison (e.g. table=box: "
+                   "the reference's table, whose edges a pushed cube can fall off)")  # fmt: skip
+    p.add_argument("--out", default=None, metavar="FILE.json",
+                   help="default: RUN_DIR/reference.json (with --scripted: scripted-TASK.json)")  # fmt: skip
+    p.add_argument("--traces", default=None, metavar="FILE.npz",
+                   help="also trace both simulators from the same starts and goals (distance to goal, object "
+                   "speed, grip position per step) and the grip's response to a held action")  # fmt: skip
+    return p
+
+
+def scripted(task: str, episodes: int, seed: int) -> tuple[dict, dict]:
+    """The scripted controller of ``task`` from the same starts and goals in both simulators:
+    (result, traces)."""
+    import jax
+
+    with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
+        from envs.fetch.scripted import CONTROLLERS
+        from splid_jax.runtime.loop import make_env
+    import_reference()
+    env = make_env(task)
+    act = CONTROLLERS[task]
+    tr = traces(env, task, act, jax.jit(act), episodes, seed)
+    result = {"scripted": task, "task": task, "reference": REFERENCE_IDS[task], "seed": seed}
+    for sim in ("ours", "fetch"):
+        succ, dist = tr[f"{sim}_success"], tr[f"{sim}_distance"][:, -1]
+        result[sim] = summarise(succ.any(axis=1), succ[:, -1], dist)
+    return result, tr
+
+
+def main(argv: list[str] | None = None) -> int:
+    from splid_jax.runtime.checkpoint import CheckpointError
+
+    p = build_parser()
+    a = p.parse_args(argv)
+    try:
+        if not a.reference:
+            raise EvaluationError("pass --reference (the evaluation in our task alone is what train reports)")
+        if (a.run_dir is None) == (a.scripted is None):
+            raise EvaluationError("give either RUN_DIR or --scripted TASK")
+        if a.episodes < 1:
+            raise EvaluationError(f"--episodes {a.episodes}: must be >= 1")
+        if a.run_dir is not None and not os.path.isdir(a.run_dir):
+            raise EvaluationError(f"{a.run_dir} is not a directory")
+        out = a.out or (os.path.join(a.run_dir, "reference.json") if a.run_dir else f"scripted-{a.scripted}.json")
+        if not os.path.isdir(os.path.dirname(os.path.abspath(out))):
+            raise EvaluationError(f"--out {out}: its directory does not exist")
+        if a.scripted:
+            result, tr = scripted(a.scripted, a.episodes, a.seed)
+            title = f"the scripted {a.scripted} controller, the same {a.episodes} starts in each"
+        else:
+            import_reference()  # a missing extra fails before the checkpoint is read
+            loaded = load_run(a.run_dir, a.step, a.env_options)
+            result = evaluate(a.run_dir, a.episodes, a.seed, loaded=loaded)
+            what = f"{result['algo']} on {result['task']}, iteration {result['step']}"
+            title = f"{a.run_dir} ({what}), {a.episodes} episodes each"
+            if a.traces:
+                cfg, env, trainer, pstate, _ = loaded
+                pol = lambda o, g: trainer.policy.act(pstate, o, g)  # noqa: E731
+                tr = traces(env, cfg.env, pol, policy_act(trainer, pstate), a.episodes, a.seed)
+    except (EvaluationError, InvalidConfig, CheckpointError) as err:
+        print(f"{p.prog}: error: {err}", file=sys.stderr)
+        return 2
+    print(title + ":")
+    print(_line("ours (MJX)", result["ours"]))
+    print(_line(result["reference"], result["fetch"]))
+    if a.traces:
+        from splid_jax.runtime.loop import make_env
+
+        resp = step_response(make_env(result["task"]), result["task"])
+        np.savez_compressed(a.traces, **tr, **{f"response_{k}": np.asarray(resp[k]) for k in RESPONSE_KEYS})
+        result["traces"] = {"file": a.traces, "ours": split_by_final(tr, "ours"), "fetch": split_by_final(tr, "fetch")}
+        result["step_response"] = resp
+        result["slots"] = compare_slots(tr["ours_obs"], tr["fetch_obs"])
+        print(f"traces: {a.traces} (same starts and goals in both; by final-step outcome in the JSON)")
+    write_json_atomic(out, result)
+    print(f"wrote {out}")
+    return 0

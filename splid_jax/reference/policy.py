@@ -1,0 +1,111 @@
+"""A run's deterministic policy loaded from its checkpoint (a run of train, or a member of a sweep,
+sliced out of the sweep's stacked checkpoint), and its evaluation in both simulators."""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import io
+import json
+import os
+
+import numpy as np
+
+from splid_jax.reference.episodes import run_reference, summarise
+from splid_jax.reference.extra import REFERENCE_IDS, EvaluationError, import_reference, reference_id
+
+
+def sweep_member(run_dir: str) -> tuple[str, int, int] | None:
+    """(sweep directory, member index, members) when ``run_dir`` is a member of a sweep, whose
+    checkpoints the sweep directory holds, stacked over members."""
+    parent = os.path.dirname(os.path.abspath(run_dir))
+    path = os.path.join(parent, "sweep.json")
+    if not os.path.isfile(path):
+        return None
+    with open(path) as fh:
+        names = [m.get("run_dir") for m in json.load(fh).get("members", [])]
+    name = os.path.basename(os.path.abspath(run_dir))
+    return (parent, names.index(name), len(names)) if name in names else None
+
+
+def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
+    """A sweep member's task, algorithm, state and step, sliced out of the sweep's stacked checkpoint
+    (laid out as the sweep's own config builds it; members differ only in data, not in shapes)."""
+    import jax
+
+    from splid_jax.config import TrainConfig
+    from splid_jax.learners.registry import make_algorithm
+    from splid_jax.runtime import checkpoint
+    from splid_jax.runtime.loop import make_env
+
+    directory, index, members = sweep
+    env = make_env(cfg.env, **cfg.env_overrides())  # the member's task, with any changed fields
+    with open(os.path.join(directory, "sweep.json")) as fh:
+        trainer = make_algorithm(TrainConfig.from_json(json.load(fh)["config"], run_dir=directory), env)
+    like = jax.eval_shape(jax.vmap(trainer.init), jax.random.split(jax.random.PRNGKey(0), members))
+    step, state, _ = checkpoint.restore(directory, like, step=step)
+    return env, trainer, jax.tree.map(lambda x: x[index], state), step
+
+
+def load_run(run_dir: str, step: int | None = None, env_options: str = ""):
+    """(config, our task, algorithm, the policy's ``PolicyState``, step) of the run in ``run_dir``: a
+    run of train, or a member of a sweep. ``env_options`` (``KEY=VALUE,...``) change our task's fields
+    from the run's, e.g. ``table=box`` to put the reference's table edges in our task."""
+    from splid_jax.common.networks import PolicyState
+    from splid_jax.rollout import load_config, load_policy
+    from splid_jax.runtime import checkpoint
+
+    if not os.path.isdir(run_dir):
+        raise EvaluationError(f"{run_dir} is not a directory")
+    cfg = load_config(run_dir)
+    if env_options:
+        cfg = dataclasses.replace(cfg, env_options=",".join(filter(None, (cfg.env_options, env_options))))
+    reference_id(cfg.env)
+    sweep = sweep_member(run_dir) if checkpoint.latest_step(run_dir) is None else None
+    if checkpoint.latest_step(run_dir) is None and (sweep is None or checkpoint.latest_step(sweep[0]) is None):
+        raise EvaluationError(f"{run_dir} holds no checkpoint (train writes them in {run_dir}/checkpoints)")
+    with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
+        if sweep is None:
+            env, trainer, state, step = load_policy(cfg, step)
+        else:
+            env, trainer, state, step = _restore_member(cfg, sweep, step)
+    pstate = getattr(state, "policy", None)
+    if not isinstance(pstate, PolicyState):
+        raise EvaluationError(f"the checkpoint of {run_dir} holds no policy (no networks.PolicyState at .policy)")
+    return cfg, env, trainer, pstate, step
+
+
+def policy_act(trainer, pstate):
+    """The deterministic policy as ``act(obs, goal) -> action``, jitted, batched over leading axes."""
+    import jax
+
+    return jax.jit(lambda o, g: trainer.policy.act(pstate, o, g))
+
+
+def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None = None, env_options: str = "",
+             loaded: tuple | None = None) -> dict:  # fmt: skip
+    """The run's policy in the reference (its own resets, seeds ``seed`` ...) and in our task (the
+    project's evaluation draw: ``rollout.rollout`` from ``PRNGKey(seed)``), ``episodes`` each.
+    ``loaded``: what ``load_run`` gave, to load the checkpoint once."""
+    import jax
+
+    from splid_jax.rollout import rollout
+
+    import_reference()  # a missing extra fails before any work
+    cfg, env, trainer, pstate, step = loaded or load_run(run_dir, step, env_options)
+    states = jax.jit(lambda ps, k: rollout(env, trainer, ps, k, episodes))(pstate, jax.random.PRNGKey(seed))
+    succ = np.asarray(states.success[1:] & ~states.invalid[1:])
+    dist = np.linalg.norm(np.asarray(states.achieved_goal[-1] - states.desired_goal[-1]), axis=-1)
+    ours = summarise(succ.any(axis=0), succ[-1], dist)
+    ref = run_reference(cfg.env, policy_act(trainer, pstate), episodes, seed).summary()
+    return {
+        "run_dir": run_dir,
+        "algo": cfg.algo,
+        "task": cfg.env,
+        "reference": REFERENCE_IDS[cfg.env],
+        "step": int(step),
+        "seed": seed,
+        "env_options": cfg.env_options,
+        "ours": ours,
+        "fetch": ref,
+    }

@@ -1,0 +1,109 @@
+"""The command line: its one-line errors (exit code 2), and a run's policy and the scripted Push from
+the same starts in both simulators."""
+
+import builtins
+import json
+
+import jax
+import numpy as np
+import pytest
+
+pytest.importorskip("gymnasium_robotics")
+
+from envs.fetch import scripted  # noqa: E402
+from splid_jax.config import TrainConfig  # noqa: E402
+from splid_jax.learners.registry import make_algorithm  # noqa: E402
+from splid_jax.reference import cli, episodes  # noqa: E402
+from splid_jax.runtime import checkpoint  # noqa: E402
+from splid_jax.runtime.loop import make_env  # noqa: E402
+from splid_jax.runtime.run_files import env_settings  # noqa: E402
+
+
+def _init_run(run_dir, env_name: str, **fields):
+    """A run directory holding the untrained state of a small run: config.json and checkpoint 0."""
+    cfg = TrainConfig(env=env_name, iterations=1, eval_every=1, num_envs=2, horizon=2, hidden=(8,), buffer_size=16,
+                      batch_size=4, run_dir=str(run_dir), **fields)  # fmt: skip
+    env = make_env(cfg.env, **cfg.env_overrides())
+    checkpoint.save(run_dir, 0, make_algorithm(cfg, env).init(jax.random.PRNGKey(0)), {"env": env_settings(env)})
+    (run_dir / "config.json").write_text(json.dumps(cfg.to_json()))
+    return run_dir
+
+
+def _error(capsys, argv) -> str:
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "Traceback" not in err
+    return err
+
+
+def test_missing_extra_is_one_line(tmp_path, capsys, monkeypatch):
+    real = builtins.__import__
+
+    def no_gym(name, *a, **k):
+        if name.split(".")[0] in ("gymnasium", "gymnasium_robotics"):
+            raise ImportError(name)
+        return real(name, *a, **k)
+
+    monkeypatch.setattr(builtins, "__import__", no_gym)
+    assert 'pip install -e ".[reference]"' in _error(capsys, [str(tmp_path), "--reference"])
+
+
+def test_task_without_reference_is_one_line(tmp_path, capsys):
+    cfg = TrainConfig(env="point", run_dir=str(tmp_path))
+    (tmp_path / "config.json").write_text(json.dumps(cfg.to_json()))
+    assert "no reference simulator" in _error(capsys, [str(tmp_path), "--reference"])
+
+
+def test_directory_without_run_or_checkpoint_is_one_line(tmp_path, capsys):
+    assert "run_dir" in _error(capsys, [str(tmp_path), "--reference"])  # no config.json
+    assert "is not a directory" in _error(capsys, [str(tmp_path / "absent"), "--reference"])
+    cfg = TrainConfig(env="reach", run_dir=str(tmp_path))
+    (tmp_path / "config.json").write_text(json.dumps(cfg.to_json()))
+    assert "no checkpoint" in _error(capsys, [str(tmp_path), "--reference"])
+
+
+def test_checkpoint_without_policy_is_one_line(tmp_path, capsys, monkeypatch):
+    import splid_jax.rollout
+
+    run = _init_run(tmp_path / "run", "reach")
+    monkeypatch.setattr(splid_jax.rollout, "load_policy", lambda cfg, step: (None, None, object(), 0))
+    assert "holds no policy" in _error(capsys, [str(run), "--reference"])
+
+
+def test_reference_flag_is_required(tmp_path, capsys):
+    assert "--reference" in _error(capsys, [str(tmp_path)])
+
+
+@pytest.mark.slow
+def test_evaluator_on_reach_writes_both_simulators_numbers_and_traces(tmp_path, capsys):
+    run = _init_run(tmp_path / "run", "reach")
+    assert cli.main([str(run), "--reference", "--episodes", "3", "--traces", str(tmp_path / "t.npz")]) == 0
+    out = capsys.readouterr().out
+    assert "FetchReach-v4" in out and "ours (MJX)" in out
+    got = json.loads((run / "reference.json").read_text())
+    for side in ("ours", "fetch"):
+        assert got[side]["episodes"] == 3
+        assert 0 <= got[side]["success_final"] <= got[side]["success_any"] <= 1
+        lo, hi = got[side]["success_any_ci95"]
+        assert lo <= got[side]["success_any"] <= hi
+    tr = np.load(tmp_path / "t.npz")
+    assert tr["ours_distance"].shape == tr["fetch_distance"].shape == (3, 51)
+    np.testing.assert_allclose(tr["ours_distance"][:, 0], tr["fetch_distance"][:, 0], atol=2e-3)  # same starts
+    assert tr["ours_obs"].shape == tr["fetch_obs"].shape == (3, 51, 10)
+    assert set(got["slots"]) >= {"grip x", "finger vel r"}
+    assert tr["response_fetch_step"].shape == tr["response_ours_rest_step"].shape == (20, 3)
+
+
+@pytest.mark.slow
+def test_evaluator_on_push_and_the_scripted_push_in_both_simulators(tmp_path, capsys):
+    run = _init_run(tmp_path / "run", "push")
+    assert cli.main([str(run), "--reference", "--episodes", "2", "--out", str(tmp_path / "r.json")]) == 0
+    got = json.loads((tmp_path / "r.json").read_text())
+    assert got["reference"] == "FetchPush-v4" and got["fetch"]["episodes"] == 2
+    # the mapping: the scripted controller, fed each simulator's raw observation, pushes the cube home in both
+    env = make_env("push")
+    act = jax.jit(scripted.push)
+    ours, ref = episodes.matched_episodes(env, "push", scripted.push, act, 2, 0)
+    np.testing.assert_allclose(ours.obs[:, 0, :9], ref.obs[:, 0, :9], atol=2e-3)  # same start, same layout
+    np.testing.assert_allclose(ours.goal, ref.goal, atol=2e-3)
+    assert ours.success[:, -1].all() and ref.success[:, -1].all()
