@@ -16,12 +16,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import statistics
 import sys
 import time
 
 import jax
 import jax.numpy as jnp
+from bench_splid import timed  # this folder's scripts share their timer
 
 from splid_jax.common.evaluation import evaluate
 from splid_jax.config import TrainConfig
@@ -31,19 +31,6 @@ from splid_jax.learners.imitation.explore import draws, rollout
 from splid_jax.learners.registry import make_algorithm
 from splid_jax.learners.splid.select import select
 from splid_jax.runtime.loop import make_env
-
-
-def timed(fn, *args, repeats: int) -> tuple[dict, object]:
-    t0 = time.perf_counter()
-    out = jax.block_until_ready(fn(*args))
-    first = time.perf_counter() - t0
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = jax.block_until_ready(fn(*args))
-        times.append(time.perf_counter() - t0)
-    med = statistics.median(times)
-    return {"median_s": med, "compile_s": max(first - med, 0.0), "times_s": times}, out
 
 
 def warm(chunk, state, hyper, chunks: int):

@@ -16,7 +16,7 @@ and the sweeps' directories), ``runs`` (training), ``merging`` (parts trained ap
 
 from __future__ import annotations
 
-import importlib
+from splid_jax.common.lazy import lazy_names
 
 _HOMES = {
     "splid_jax.figures.registry": ("METHODS", "SHORT", "SPECS", "SUCCESS", "Method", "Spec", "member_name"),
@@ -41,15 +41,4 @@ _HOMES = {
     "splid_jax.figures.cli": ("HELP", "build_parser", "main"),
     "splid_jax.common.errors": ("InvalidConfig",),
 }
-_HOME_OF = {name: module for module, names in _HOMES.items() for name in names}
-__all__ = sorted(_HOME_OF)
-
-
-def __getattr__(name: str):
-    if name not in _HOME_OF:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(_HOME_OF[name]), name)
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__, __all__ = lazy_names(__name__, _HOMES)

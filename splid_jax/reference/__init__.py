@@ -65,7 +65,7 @@ reachable from this package too, loaded on first use.
 
 from __future__ import annotations
 
-import importlib
+from splid_jax.common.lazy import lazy_names
 
 _HOMES = {
     "splid_jax.reference.extra": (
@@ -101,15 +101,4 @@ _HOMES = {
     "splid_jax.reference.policy": ("evaluate", "load_run", "policy_act", "sweep_member"),
     "splid_jax.reference.cli": ("build_parser", "main", "scripted", "write_json_atomic"),
 }
-_HOME_OF = {name: module for module, names in _HOMES.items() for name in names}
-__all__ = sorted(_HOME_OF)
-
-
-def __getattr__(name: str):
-    if name not in _HOME_OF:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(_HOME_OF[name]), name)
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__, __all__ = lazy_names(__name__, _HOMES)
