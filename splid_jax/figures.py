@@ -40,7 +40,7 @@ from splid_jax.common.errors import InvalidConfig, check  # noqa: E402
 from splid_jax.common.values import read_value, typed_value  # noqa: E402
 from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
 from splid_jax.learners import registry  # noqa: E402
-from splid_jax.runtime import checkpoint, loop, progress  # noqa: E402
+from splid_jax.runtime import checkpoint, lock, loop, progress  # noqa: E402
 
 SPEC = "figure.json"  # the figure's command, device, date and what each method ran
 
@@ -239,7 +239,7 @@ def device_name() -> str:
 
 
 def check_out(out: str) -> None:
-    if os.path.isdir(out) and os.listdir(out):
+    if os.path.isdir(out) and set(os.listdir(out)) - {lock.LOCK}:
         raise InvalidConfig("out", out, "a new or empty directory (--replot redraws the figure in it)")
     check(not os.path.exists(out) or os.path.isdir(out), "out", out, "a directory, not a file")
     loop.check_writable(out)
@@ -627,43 +627,44 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     use_compile_cache(ns.compile_cache)
     try:
-        if ns.merge:
-            check(not (ns.replot or ns.resume), "merge", " ".join(ns.merge), "given without --replot or --resume")
-            check(ns.out is not None, "out", None, "the new directory --merge joins the parts into")
-            merge(out, ns.merge, ns.figure, shlex.join(["python", "-m", "splid_jax.figures", *argv]))
-        elif ns.replot or ns.resume:
-            check(not (ns.replot and ns.resume), "replot", True, "given without --resume")
-            if ns.resume:
-                train(out, load_record(out), ns.quiet, resume=True)
-        else:
-            check(env_name in envs.names(), "env", env_name, "one of " + ", ".join(envs.names()))
-            check(not ns.quick or env_name == "point", "env", env_name, "point with --quick")
-            if ns.methods is None:
-                methods = spec.methods
+        with lock.hold(out, field="out"):  # one process per figure directory
+            if ns.merge:
+                check(not (ns.replot or ns.resume), "merge", " ".join(ns.merge), "given without --replot or --resume")
+                check(ns.out is not None, "out", None, "the new directory --merge joins the parts into")
+                merge(out, ns.merge, ns.figure, shlex.join(["python", "-m", "splid_jax.figures", *argv]))
+            elif ns.replot or ns.resume:
+                check(not (ns.replot and ns.resume), "replot", True, "given without --resume")
+                if ns.resume:
+                    train(out, load_record(out), ns.quiet, resume=True)
             else:
-                check(ns.figure == "fig3", "methods", ns.methods, "given only for fig3")
-                methods = parse_methods(ns.methods, spec.methods)
-            budget = ns.episodes
-            if budget is None:
-                budget = QUICK_EPISODES if ns.quick else default_budget(env_name)
-            sets = parse_sets(ns.set, methods)
-            values = _values(spec, ns.values)
-            check_out(out)
-            plans = plan(spec, env_name, methods, ns.seeds, budget, sets, out, values, ns.quick)
-            record = {
-                "figure": ns.figure,
-                "env": env_name,
-                "methods": list(methods),
-                "seeds": ns.seeds,
-                "budget_episodes": budget,
-                "device": device_name(),
-                "date": today,
-                "command": shlex.join(["python", "-m", "splid_jax.figures", *argv]),
-                "runs": describe(plans),
-            }
-            os.makedirs(out, exist_ok=True)
-            train(out, record, ns.quiet)
-        png, table = render(out, ns.quiet)
+                check(env_name in envs.names(), "env", env_name, "one of " + ", ".join(envs.names()))
+                check(not ns.quick or env_name == "point", "env", env_name, "point with --quick")
+                if ns.methods is None:
+                    methods = spec.methods
+                else:
+                    check(ns.figure == "fig3", "methods", ns.methods, "given only for fig3")
+                    methods = parse_methods(ns.methods, spec.methods)
+                budget = ns.episodes
+                if budget is None:
+                    budget = QUICK_EPISODES if ns.quick else default_budget(env_name)
+                sets = parse_sets(ns.set, methods)
+                values = _values(spec, ns.values)
+                check_out(out)
+                plans = plan(spec, env_name, methods, ns.seeds, budget, sets, out, values, ns.quick)
+                record = {
+                    "figure": ns.figure,
+                    "env": env_name,
+                    "methods": list(methods),
+                    "seeds": ns.seeds,
+                    "budget_episodes": budget,
+                    "device": device_name(),
+                    "date": today,
+                    "command": shlex.join(["python", "-m", "splid_jax.figures", *argv]),
+                    "runs": describe(plans),
+                }
+                os.makedirs(out, exist_ok=True)
+                train(out, record, ns.quiet)
+            png, table = render(out, ns.quiet)
     except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 2

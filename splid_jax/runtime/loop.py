@@ -31,7 +31,7 @@ from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 from splid_jax.learners import registry
 from splid_jax.learners.base import EVAL_KEYS, Algorithm
-from splid_jax.runtime import checkpoint, devices, multihost, progress
+from splid_jax.runtime import checkpoint, devices, lock, multihost, progress
 from splid_jax.runtime.groups import Groups
 from splid_jax.runtime.memory import DoesNotFit, check_memory, compile_hint, gigabytes, largest_value, nbytes, sizes
 from splid_jax.runtime.run_files import (
@@ -132,11 +132,11 @@ def run(
     ``members``: the configs of a sweep's members (each its own seed, run_dir and traced settings),
     trained in lock-step as one vmapped program with checkpoints under ``cfg.run_dir``. Over several
     processes every process calls it alike and each returns the records; only process 0 writes and shows."""
-    env = env or make_env(cfg.env, **cfg.env_overrides())
-    place = placement(cfg, None if members is None else len(members), algo)
-    split_envs = place.axis == devices.ENVS and place.count > 1
-    algo = algo or registry.make_algorithm(cfg, env, place.mesh if split_envs else None)
-    with Signals() as signals:
+    with Signals() as signals, lock.hold(cfg.run_dir, multihost.is_first()):
+        env = env or signals.wait(lambda: make_env(cfg.env, **cfg.env_overrides()))
+        place = placement(cfg, None if members is None else len(members), algo)
+        split_envs = place.axis == devices.ENVS and place.count > 1
+        algo = algo or signals.wait(lambda: registry.make_algorithm(cfg, env, place.mesh if split_envs else None))
         return _Loop(cfg, env, algo, members, place, signals, quiet).run(resume)
 
 
