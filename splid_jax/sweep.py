@@ -61,6 +61,8 @@ def members(seeds: int, sigmas: tuple[float, ...], horizons: tuple[int, ...], ba
     ok = len(sigmas) >= 1 and all(math.isfinite(s) and s >= 0 for s in sigmas)
     check(ok, "sigmas", sigmas, "one or more finite values >= 0")
     check(len(horizons) >= 1 and min(horizons) >= 1, "horizons", horizons, "one or more integers >= 1")
+    for name, values in (("sigmas", sigmas), ("horizons", horizons)):  # two members would share one directory
+        check(len(set(values)) == len(values), name, ",".join(map(str, values)), "distinct values")
     return [Member(base_seed + s, float(sg), int(h)) for sg, h, s in itertools.product(sigmas, horizons, range(seeds))]
 
 

@@ -182,16 +182,21 @@ class _Loop:
     def start(self, resume: bool, step: int | None) -> list[dict]:
         cfg, algo = self.cfg, self.algo
 
-        keys = [jax.random.PRNGKey(m.seed) for m in self.lanes]
-        hypers = [_lane_hyper(algo, cfg, m) for m in self.lanes]
-        init, chunk = algo.init, algo.chunk
         place = self.place
-        if self.stacked:
-            keys, hyper = jnp.stack(keys), jax.tree.map(lambda *x: jnp.stack(x), *hypers)
-            init, chunk = jax.vmap(init), jax.vmap(chunk)
-        else:
-            keys, hyper = keys[0], hypers[0]
         split = self.stacked and place.axis == devices.MEMBERS and place.count > 1
+        self.check_state_fits(split)
+
+        def stack():  # seconds for a sweep of thousands of members: a signal must not wait for it
+            keys = [jax.random.PRNGKey(m.seed) for m in self.lanes]
+            hypers = [_lane_hyper(algo, cfg, m) for m in self.lanes]
+            if self.stacked:
+                return jnp.stack(keys), jax.tree.map(lambda *x: jnp.stack(x), *hypers)
+            return keys[0], hypers[0]
+
+        keys, hyper = self.signals.wait(stack)
+        init, chunk = algo.init, algo.chunk
+        if self.stacked:
+            init, chunk = jax.vmap(init), jax.vmap(chunk)
         groups = Groups(place, len(self.lanes)) if split else None
         sharding = place.state_sharding() if groups is None else jax.sharding.SingleDeviceSharding(self.device)
         like = _abstract(jax.eval_shape(init, keys), sharding)  # the whole sweep's, as checkpoints hold it
@@ -243,6 +248,14 @@ class _Loop:
             write_json(os.path.join(cfg.run_dir, SWEEP), {"config": cfg.to_json(), "members": named})
         self.groups = groups
         return self.train(compiled, state, hyper, step or 0, select_steps, wall_before)
+
+    def check_state_fits(self, split: bool) -> None:
+        """One member's state times the members a device holds, twice (the state and its update),
+        against the device's memory: a grid of thousands is refused before anything is stacked or traced."""
+        one = sum(nbytes(x) for x in jax.tree.leaves(jax.eval_shape(self.algo.init, jax.random.PRNGKey(0))))
+        held = -(-len(self.lanes) // self.place.count) if split else len(self.lanes)
+        what = f"state {gigabytes(one)} per member x {held} members, twice" if self.stacked else "state twice"
+        check_memory(2 * one * held, what, self.device, self.cfg, len(self.lanes))
 
     def restore(self, like):
         cfg = self.cfg

@@ -44,12 +44,28 @@ def test_cli_rejects_a_bad_grid(capsys, tmp_path):
         (["--sigmas", "inf"], "sigmas"),
         (["--horizons", "2.5"], "horizons"),
         (["--seed", "-1"], "seed"),
+        (["--horizons", "4,4"], "horizons"),  # two members would share one directory
+        (["--sigmas", "1,1.0"], "sigmas"),
     ],
 )
 def test_cli_names_the_field_of_a_bad_value(capsys, tmp_path, args, field):
     assert sweep.main(["--env", "point", *args, "--run-dir", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+    assert not (tmp_path / "x").exists()
+
+
+def test_a_grid_too_large_for_memory_is_refused_before_it_is_stacked(capsys, tmp_path, monkeypatch):
+    from splid_jax.runtime import loop
+
+    def stack(*a, **kw):
+        raise AssertionError("stacked before the size check")
+
+    monkeypatch.setattr(loop, "_lane_hyper", stack)
+    args = ["--env", "point", "--iterations", "5", "--eval-every", "5", "--seeds", "20000", "--buffer-size", "2000000"]
+    assert sweep.main([*args, "--run-dir", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "20000 sweep members" in err and "per member" in err
     assert not (tmp_path / "x").exists()
 
 
