@@ -64,6 +64,11 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
     if ns.resume is None:
         refuse_unread(given, given.get("algo", "splid"))
         return TrainConfig(**given), False
+    if not ns.resume.strip():
+        raise InvalidConfig("resume", ns.resume, "a run directory holding config.json")
+    if given.get("run_dir", ns.resume) != ns.resume:  # the run continues where its checkpoints are
+        raise InvalidConfig("run_dir", given["run_dir"], f"unset with --resume (the run continues in {ns.resume})")
+    given.pop("run_dir", None)
     path = os.path.join(ns.resume, "config.json")
     if not os.path.isfile(path):
         raise InvalidConfig("resume", ns.resume, "a run directory holding config.json")

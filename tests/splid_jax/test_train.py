@@ -75,7 +75,8 @@ def final_params(run_dir):
         (["--seed", "99999999999999999999"], "seed"),
         (["--sigma", "inf"], "sigma"),
         (["--sigma", "nan"], "sigma"),
-        (["--num-envs", "100000000"], "num_envs"),  # refused from its shapes, before anything is allocated
+        (["--num-envs", "100000000"], "num_envs"),
+        (["--run-dir", ""], "run_dir"),  # refused from its shapes, before anything is allocated
     ],
 )
 def test_bad_values_stop_before_any_work(tmp_path, capsys, args, field):
@@ -312,3 +313,43 @@ def test_sigterm_saves_like_ctrl_c_and_the_run_resumes(tmp_path):
     assert step >= 10 and f"saved iteration {step} " in out
     assert main(["--resume", run_dir, "--iterations", str(step + 5), "--quiet"]) == 0
     assert [r["iteration"] for r in stable(run_dir)] == list(range(5, step + 10, 5))
+
+
+def test_bad_resumes_and_bad_saved_configs_are_one_line(tmp_path, capsys):
+    run_dir = tmp_path / "run"
+    assert main([*TINY, "--iterations", "5", "--run-dir", str(run_dir), "--quiet"]) == 0
+    files = {p: (run_dir / p).read_bytes() for p in ("config.json", "metrics.jsonl")}
+    capsys.readouterr()
+    assert main(["--resume", str(run_dir), "--run-dir", str(tmp_path / "x"), "--iterations", "10"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "invalid run_dir=" in err and "unset with --resume" in err
+    assert not (tmp_path / "x").exists()
+    saved = json.loads(files["config.json"])
+    for field, value in [("sigma", "high"), ("hidden", ["a", 64, 64]), ("num_envs", 32.5)]:
+        (run_dir / "config.json").write_text(json.dumps({**saved, field: value}))
+        assert main(["--resume", str(run_dir), "--iterations", "10"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and f"invalid {field}=" in err, err
+    (run_dir / "config.json").write_bytes(files["config.json"])
+    assert (run_dir / "metrics.jsonl").read_bytes() == files["metrics.jsonl"]
+    assert checkpoint.latest_step(str(run_dir)) == 5
+
+
+def test_a_full_disk_is_one_line_exit_3_and_keeps_the_last_whole_checkpoint(tmp_path, capsys, monkeypatch):
+    import errno
+
+    real_save, saves = checkpoint.save, []
+
+    def fills_up(run_dir, step, *a, **kw):
+        saves.append(step)
+        if len(saves) > 1:
+            raise OSError(errno.ENOSPC, "No space left on device", run_dir)
+        return real_save(run_dir, step, *a, **kw)
+
+    monkeypatch.setattr(checkpoint, "save", fills_up)
+    run_dir = tmp_path / "run"
+    args = [*TINY, "--iterations", "15", "--checkpoint-every", "1", "--run-dir", str(run_dir), "--quiet"]
+    assert main(args) == 3
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "no space left" in err and "iteration 5 is kept" in err
+    assert checkpoint.latest_step(str(run_dir)) == 5
