@@ -120,9 +120,9 @@ def build_parser() -> Parser:
     add_config_flags(
         parser, TrainConfig, TASK_DEFAULTS, exclude=frozenset({"sigma", "horizon"}), per_algo=registry.task_defaults()
     )
-    parser.add_argument("--seeds", type=int, default=4, help="seeds per grid point (default: 4)")
-    parser.add_argument("--sigmas", default="1.0", help="comma-separated sigma values (default: 1.0)")
-    parser.add_argument("--horizons", default="8", help="comma-separated H values (default: 8)")
+    parser.add_argument("--seeds", type=int, default=None, help="seeds per grid point (default: 4)")
+    parser.add_argument("--sigmas", default=None, help="comma-separated sigma values (default: 1.0)")
+    parser.add_argument("--horizons", default=None, help="comma-separated H values (default: 8)")
     parser.add_argument("--resume", metavar="RUN_DIR", help="continue the sweep saved in RUN_DIR (its sweep.json)")
     parser.add_argument("--no-plot", action="store_true", help="skip the grid figure")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
@@ -149,6 +149,18 @@ def resume_configs(run_dir: str, given: dict) -> tuple[TrainConfig, list[TrainCo
     return base, lanes
 
 
+def check_same_grid(lanes: list[TrainConfig], seeds: int | None, sigmas: str | None, horizons: str | None) -> None:
+    """A resumed sweep trains the grid it started with: a grid flag given anew must name that grid."""
+    first = {"seeds": len({m.seed for m in lanes}), "sigmas": tuple(dict.fromkeys(m.sigma for m in lanes)),
+             "horizons": tuple(dict.fromkeys(m.horizon for m in lanes))}  # fmt: skip
+    given = {"seeds": seeds, "sigmas": None if sigmas is None else _values("sigmas", sigmas, float),
+             "horizons": None if horizons is None else _values("horizons", horizons, int)}  # fmt: skip
+    for name, value in given.items():
+        if value is not None and value != first[name]:
+            shown = ",".join(map(str, first[name])) if isinstance(first[name], tuple) else first[name]
+            raise InvalidConfig(name, value, f"{shown} as in the sweep being resumed (only iterations may change)")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     ns = parser.parse_args(_join_negative(sys.argv[1:] if argv is None else argv))
@@ -158,11 +170,14 @@ def main(argv: list[str] | None = None) -> int:
         given = explicit_values(TrainConfig, ns)
         if ns.resume:  # its sweep.json: process 0's
             cfg, lanes = multihost.from_first(lambda: resume_configs(ns.resume, given))
+            check_same_grid(lanes, ns.seeds, ns.sigmas, ns.horizons)
         else:
             refuse_unread(given, given.get("algo", "splid"))
             given.setdefault("run_dir", os.path.join("runs", f"sweep-{given.get('env', 'point')}"))
-            sigmas, horizons = _values("sigmas", ns.sigmas, float), _values("horizons", ns.horizons, int)
-            grid = members(ns.seeds, sigmas, horizons, base_seed=given.get("seed", 0))
+            sigmas = _values("sigmas", "1.0" if ns.sigmas is None else ns.sigmas, float)
+            horizons = _values("horizons", "8" if ns.horizons is None else ns.horizons, int)
+            seeds = 4 if ns.seeds is None else ns.seeds
+            grid = members(seeds, sigmas, horizons, base_seed=given.get("seed", 0))
             cfg, lanes = member_configs(TrainConfig(**{**given, "horizon": max(horizons), "sigma": max(sigmas)}), grid)
         env = make_env(cfg.env, **cfg.env_overrides())
         cfg.check_env(env)

@@ -86,6 +86,13 @@ def test_a_second_sweep_into_one_dir_is_refused_and_a_sweep_resumes(capsys, tmp_
     assert sweep.main([*args, "--iterations", "4", "--sigmas", "0.5", "--run-dir", run_dir]) == 2
     assert "run_dir" in capsys.readouterr().err
     assert read(tmp_path / "sweep" / "sigma1-H4-s0" / "metrics.jsonl") == kept
-    assert sweep.main(["--resume", run_dir, "--iterations", "4", "--no-plot", "--quiet"]) == 0
+    other_grids = [(["--seeds", "3"], "seeds"), (["--sigmas", "0.5"], "sigmas"), (["--horizons", "2"], "horizons")]
+    for grid, field in other_grids:
+        assert sweep.main(["--resume", run_dir, *grid, "--iterations", "4", "--no-plot", "--quiet"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and f"invalid {field}=" in err and "as in the sweep being resumed" in err
+    assert read(tmp_path / "sweep" / "sigma1-H4-s0" / "metrics.jsonl") == kept
+    same = ["--seeds", "2", "--sigmas", "1", "--horizons", "4"]  # the grid it started with may be given again
+    assert sweep.main(["--resume", run_dir, *same, "--iterations", "4", "--no-plot", "--quiet"]) == 0
     recs = read(tmp_path / "sweep" / "sigma1-H4-s1" / "metrics.jsonl")
     assert [r["iteration"] for r in recs] == [2, 4]
