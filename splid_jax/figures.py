@@ -15,9 +15,11 @@ if __name__ == "__main__":  # a signal while JAX loads ends the process with one
     quiet_interrupts()
 
 import argparse  # noqa: E402
+import contextlib  # noqa: E402
 import csv  # noqa: E402
 import dataclasses  # noqa: E402
 import datetime  # noqa: E402
+import io  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import os  # noqa: E402
@@ -302,7 +304,7 @@ def merge(out: str, parts: Sequence[str], figure: str, command: str) -> dict:
     copied into ``out`` (checkpoints too, so ``--resume`` continues an unfinished one) and their records
     joined; the parts stay as they are."""
     check(len(parts) >= 2, "merge", " ".join(parts), "two or more figure directories")
-    records = [load_record(p) for p in parts]
+    records = [load_record(p, "merge") for p in parts]
     first, spec = records[0], SPECS[figure]
     check(first["figure"] == figure, "merge", parts[0], f"a {figure} directory")
     for part, record in zip(parts, records, strict=True):
@@ -367,15 +369,35 @@ class Series:
 MEASURES = ("eval_success", "eval_success_final", "eval_return")
 
 
-def load_record(out: str) -> dict:
+def load_record(out: str, field: str = "out") -> dict:
+    """OUT/figure.json; a missing or unreadable one is blamed on ``field``, the flag that named OUT."""
     path = os.path.join(out, SPEC)
     try:
         with open(path) as fh:
             record = json.load(fh)
-        check(record.get("figure") in SPECS, "replot", out, f"a figure directory ({path} names no figure)")
+        check(isinstance(record, dict) and record.get("figure") in SPECS, field, out,
+              f"a figure directory ({path} names no figure)")  # fmt: skip
         return record
-    except (OSError, json.JSONDecodeError):
-        raise InvalidConfig("replot", out, f"a directory holding the {SPEC} a figure command wrote") from None
+    except (OSError, json.JSONDecodeError) as e:
+        why = "" if isinstance(e, FileNotFoundError | json.JSONDecodeError) else f" ({e.strerror})"
+        raise InvalidConfig(field, out, f"a directory holding the {SPEC} a figure command wrote{why}") from None
+
+
+def check_unchanged(ns: argparse.Namespace, record: dict, out: str, mode: str) -> dict:
+    """``record`` if the command asks for the figure it holds: --resume and --replot continue or redraw
+    a figure as it was started, so a setting given anew must be the one it was started with."""
+    check(ns.figure == record["figure"], "figure", ns.figure, f"{record['figure']}, the figure in {out}")
+    started = {"env": record.get("env"), "seeds": record.get("seeds"), "episodes": record.get("budget_episodes")}
+    with contextlib.suppress(SystemExit, ValueError, TypeError, KeyError), contextlib.redirect_stderr(io.StringIO()):
+        first = build_parser().parse_args(shlex.split(record["command"])[3:])
+        started |= {"set": first.set, "values": first.values, "methods": first.methods, "quick": first.quick}
+    for name in ("env", "methods", "seeds", "episodes", "values", "set", "quick"):
+        given, default = getattr(ns, name), build_parser().get_default(name)
+        if given != default and given != started.get(name, default):
+            was = started.get(name)
+            allowed = f"{was!r} as the figure in {out} was started (--{mode} changes no setting)"
+            raise InvalidConfig(name, given, allowed)
+    return record
 
 
 def load_series(out: str, record: dict) -> list[Series]:
@@ -554,7 +576,7 @@ def build_parser() -> Parser:
     parser.add_argument(
         "--methods", default=None, help="fig3: a comma-separated subset of " + ", ".join(METHODS) + " (default: all)"
     )
-    parser.add_argument("--seeds", type=int, default=5, help="seeds per method or setting (default: 5)")
+    parser.add_argument("--seeds", type=int, default=None, help="seeds per method or setting (default: 5)")
     parser.add_argument(
         "--episodes",
         type=int,
@@ -634,8 +656,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                 merge(out, ns.merge, ns.figure, shlex.join(["python", "-m", "splid_jax.figures", *argv]))
             elif ns.replot or ns.resume:
                 check(not (ns.replot and ns.resume), "replot", True, "given without --resume")
+                mode = "resume" if ns.resume else "replot"
+                record = check_unchanged(ns, load_record(out, mode), out, mode)
                 if ns.resume:
-                    train(out, load_record(out), ns.quiet, resume=True)
+                    train(out, record, ns.quiet, resume=True)
             else:
                 check(env_name in envs.names(), "env", env_name, "one of " + ", ".join(envs.names()))
                 check(not ns.quick or env_name == "point", "env", env_name, "point with --quick")
@@ -650,12 +674,13 @@ def main(argv: Sequence[str] | None = None) -> int:
                 sets = parse_sets(ns.set, methods)
                 values = _values(spec, ns.values)
                 check_out(out)
-                plans = plan(spec, env_name, methods, ns.seeds, budget, sets, out, values, ns.quick)
+                seeds = 5 if ns.seeds is None else ns.seeds
+                plans = plan(spec, env_name, methods, seeds, budget, sets, out, values, ns.quick)
                 record = {
                     "figure": ns.figure,
                     "env": env_name,
                     "methods": list(methods),
-                    "seeds": ns.seeds,
+                    "seeds": seeds,
                     "budget_episodes": budget,
                     "device": device_name(),
                     "date": today,

@@ -94,6 +94,9 @@ def test_resume_of_a_finished_figure_trains_nothing_and_redraws_it(fig3):
     runs = {p: p.read_bytes() for p in out.glob("*/*/metrics.jsonl")}
     assert figures.main(["fig3", "--resume", "--out", str(out), "--quiet"]) == 0
     assert {p: p.read_bytes() for p in out.glob("*/*/metrics.jsonl")} == runs
+    started = ["fig3", "--methods", ",".join(TRAINED), "--out", str(out), *QUICK]
+    assert figures.main([*started, "--resume"]) == 0  # the command it was started with, resumed
+    assert {p: p.read_bytes() for p in out.glob("*/*/metrics.jsonl")} == runs
     assert (out / "fig3-point.png").read_bytes()[:8] == PNG_MAGIC
 
 
@@ -120,6 +123,35 @@ def test_a_bad_argument_is_one_line_and_exit_2(capsys, tmp_path, args, field):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
     assert not out.exists()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "args, field",
+    [
+        (["fig3", "--episodes", "12800"], "episodes"),
+        (["fig3", "--seeds", "3"], "seeds"),
+        (["fig3", "--set", "learning_rate=0.01"], "set"),
+        (["fig5"], "figure"),
+        (["fig3", "--methods", "splid"], "methods"),
+    ],
+)
+@pytest.mark.parametrize("mode", ["--resume", "--replot"])
+def test_resume_and_replot_refuse_settings_the_figure_did_not_start_with(fig3, capsys, args, field, mode):
+    code, out = fig3
+    assert code == 0
+    before = {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()}
+    assert figures.main([*args, mode, "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+    assert {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()} == before
+
+
+@pytest.mark.parametrize("mode", ["--resume", "--replot"])
+def test_a_dir_without_a_figure_is_blamed_on_the_flag_that_named_it(capsys, tmp_path, mode):
+    assert figures.main(["fig3", mode, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"invalid {mode[2:]}=" in err and "figure.json" in err
 
 
 def test_replot_of_a_dir_without_a_figure_is_one_line(capsys, tmp_path):
