@@ -172,7 +172,11 @@ def main(argv: list[str] | None = None) -> int:
             cfg, lanes = multihost.from_first(lambda: resume_configs(ns.resume, given))
             check_same_grid(lanes, ns.seeds, ns.sigmas, ns.horizons)
         else:
-            refuse_unread(given, given.get("algo", "splid"))
+            algo = given.get("algo", "splid")
+            refuse_unread(given, algo)
+            for name, field in (("sigmas", "sigma"), ("horizons", "horizon")):
+                check(getattr(ns, name) is None or registry.reads(algo, field), name, getattr(ns, name),
+                      f"unset with --algo {algo}, which does not read {field}")  # fmt: skip
             given.setdefault("run_dir", os.path.join("runs", f"sweep-{given.get('env', 'point')}"))
             sigmas = _values("sigmas", "1.0" if ns.sigmas is None else ns.sigmas, float)
             horizons = _values("horizons", "8" if ns.horizons is None else ns.horizons, int)

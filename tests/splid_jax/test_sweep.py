@@ -46,6 +46,8 @@ def test_cli_rejects_a_bad_grid(capsys, tmp_path):
         (["--seed", "-1"], "seed"),
         (["--horizons", "4,4"], "horizons"),  # two members would share one directory
         (["--sigmas", "1,1.0"], "sigmas"),
+        (["--algo", "gcsl", "--horizons", "2,4"], "horizons"),  # GCSL selects nothing: H is not read
+        (["--algo", "her", "--sigmas", "0.5"], "sigmas"),
     ],
 )
 def test_cli_names_the_field_of_a_bad_value(capsys, tmp_path, args, field):

@@ -75,8 +75,16 @@ def final_params(run_dir):
         (["--seed", "99999999999999999999"], "seed"),
         (["--sigma", "inf"], "sigma"),
         (["--sigma", "nan"], "sigma"),
-        (["--num-envs", "100000000"], "num_envs"),
-        (["--run-dir", ""], "run_dir"),  # refused from its shapes, before anything is allocated
+        (["--num-envs", "100000000"], "num_envs"),  # refused from its shapes, before anything is allocated
+        (["--run-dir", ""], "run_dir"),
+        (["--bc-steps", "0"], "bc_steps"),  # no cloning step: the loss would be undefined
+        (["--gcsl-relabel", "future"], "gcsl_relabel"),  # flags the learner does not read
+        (["--pchid-every", "3"], "pchid_every"),
+        (["--algo", "gcsl", "--select"], "select"),
+        (["--algo", "gcsl", "--relabel", "settle"], "relabel"),
+        (["--algo", "gcsl", "--horizon", "3"], "horizon"),
+        (["--algo", "gcsl", "--select-radius", "0.5"], "select_radius"),
+        (["--algo", "pchid", "--gcsl-relabel", "final"], "gcsl_relabel"),
     ],
 )
 def test_bad_values_stop_before_any_work(tmp_path, capsys, args, field):
