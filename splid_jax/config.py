@@ -19,6 +19,7 @@ from splid_jax.common.fields import field
 from splid_jax.common.values import parse_overrides
 from splid_jax.learners import registry
 
+MAX_ITERATIONS = 10**7  # far beyond any run's budget: a larger value is a typo, and would run for ever
 # Keys a run's config.json holds beside the fields: where it ran, not how to run it.
 PROVENANCE = ("devices",)
 
@@ -159,7 +160,8 @@ class TrainConfig:
                 check(math.isfinite(getattr(self, f.name)), f.name, getattr(self, f.name), "a finite number")
             if f.type == "bool":  # a string such as "False" would pass every truth test
                 check(isinstance(getattr(self, f.name), bool), f.name, getattr(self, f.name), "true or false")
-        check(self.iterations >= 1, "iterations", self.iterations, "an integer >= 1")
+        in_range = 1 <= self.iterations <= MAX_ITERATIONS
+        check(in_range, "iterations", self.iterations, f"an integer in [1, {MAX_ITERATIONS}]")
         check(self.num_envs >= 1, "num_envs", self.num_envs, "an integer >= 1")
         check(self.num_devices >= 0, "num_devices", self.num_devices, "an integer >= 0 (0: every device)")
         check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "hidden", self.hidden, "one or more widths >= 1")

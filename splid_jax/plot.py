@@ -20,6 +20,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg
 
+from splid_jax.cli import Parser
 from splid_jax.runtime import progress
 
 DESCRIPTION = (
@@ -238,7 +239,7 @@ def _positive_int(text: str) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m splid_jax.plot", description=DESCRIPTION, allow_abbrev=False)
+    parser = Parser(prog="python -m splid_jax.plot", description=DESCRIPTION)
     parser.add_argument("run_dirs", nargs="+", metavar="RUN_DIR", help="run directory with metrics.jsonl")
     parser.add_argument("--out", metavar="FILE.png", help="output image (default: RUN_DIR/curves.png of the first)")
     parser.add_argument("--smooth", type=_positive_int, default=1, metavar="K", help="trailing mean over K evals")

@@ -15,7 +15,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from envs.base import step_batch
-from splid_jax.cli import add_compile_cache_flag, use_compile_cache
+from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 from splid_jax.learners.registry import make_algorithm
@@ -212,7 +212,7 @@ def check_fits(env, episodes: int, device=None) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m splid_jax.rollout", description=DESCRIPTION, allow_abbrev=False)
+    p = Parser(prog="python -m splid_jax.rollout", description=DESCRIPTION)
     p.add_argument(
         "run_dir", metavar="RUN_DIR", help="a run directory written by train (or a sweep's member directory)"
     )

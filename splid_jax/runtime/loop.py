@@ -18,6 +18,7 @@ import io
 import json
 import os
 import signal
+import sys
 import time
 from collections.abc import Sequence
 from typing import Any
@@ -138,6 +139,16 @@ def run(
         split_envs = place.axis == devices.ENVS and place.count > 1
         algo = algo or signals.wait(lambda: registry.make_algorithm(cfg, env, place.mesh if split_envs else None))
         return _Loop(cfg, env, algo, members, place, signals, quiet).run(resume)
+
+
+def warn_of_gap(path: str, kept: list[dict], step: int) -> None:
+    """A metrics file that stops short of its checkpoint (a torn last line, a deleted file) would
+    resume with a gap in its curve: said on stderr, since the records cannot be made again."""
+    last = kept[-1]["iteration"] if kept else 0
+    if last < step:
+        what = "is missing or empty" if not kept else f"ends at iteration {last}"
+        print(f"warning: {path} {what} but the checkpoint is at iteration {step}: the records of iterations "
+              f"{last + 1}-{step} are lost, so its curve has a gap there", file=sys.stderr)  # fmt: skip
 
 
 class _Loop:
@@ -270,6 +281,7 @@ class _Loop:
             for lane in self.lanes:  # lines written past the checkpoint are dropped, as is a torn last line
                 path = os.path.join(lane.run_dir, METRICS)
                 kept = [r for r in read_metrics(path) if r["iteration"] <= step]
+                warn_of_gap(path, kept, step)
                 write_atomic(path, "".join(json.dumps(r) + "\n" for r in kept))
             return step, state, meta
 

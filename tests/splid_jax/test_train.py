@@ -85,6 +85,8 @@ def final_params(run_dir):
         (["--algo", "gcsl", "--horizon", "3"], "horizon"),
         (["--algo", "gcsl", "--select-radius", "0.5"], "select_radius"),
         (["--algo", "pchid", "--gcsl-relabel", "final"], "gcsl_relabel"),
+        (["--iterations", str(10**20)], "iterations"),
+        (["--env-options", "success_radius=1,success_radius=2"], "env_options"),  # which one was meant?
     ],
 )
 def test_bad_values_stop_before_any_work(tmp_path, capsys, args, field):
@@ -99,6 +101,15 @@ def test_abbreviated_flags_are_not_taken_for_others(tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:
         main(["--learning-rat", "0.1", "--run-dir", str(tmp_path / "run")])
     assert exc.value.code == 2 and "--learning-rat" in capsys.readouterr().err
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("args", [["--nope"], ["--iterations", "x"]])
+def test_a_typo_is_one_line_pointing_at_help(tmp_path, capsys, args):
+    with pytest.raises(SystemExit) as exc:
+        main([*args, "--run-dir", str(tmp_path / "run")])
+    err = capsys.readouterr().err.strip()
+    assert exc.value.code == 2 and len(err.splitlines()) == 1 and err.endswith("--help)")
     assert not (tmp_path / "run").exists()
 
 
@@ -341,6 +352,21 @@ def test_bad_resumes_and_bad_saved_configs_are_one_line(tmp_path, capsys):
     (run_dir / "config.json").write_bytes(files["config.json"])
     assert (run_dir / "metrics.jsonl").read_bytes() == files["metrics.jsonl"]
     assert checkpoint.latest_step(str(run_dir)) == 5
+    (run_dir / "metrics.jsonl").unlink()  # its records cannot be made again: the resume says so
+    assert main(["--resume", str(run_dir), "--iterations", "10", "--quiet"]) == 0
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "warning:" in err and "missing or empty" in err and "1-5 are lost" in err
+    assert [r["iteration"] for r in stable(run_dir)] == [10]
+
+
+def test_a_torn_record_at_the_checkpoint_is_warned_of(tmp_path, capsys):
+    from splid_jax.runtime.loop import warn_of_gap
+
+    warn_of_gap("m.jsonl", [{"iteration": 5}, {"iteration": 10}], 10)
+    assert capsys.readouterr().err == ""
+    warn_of_gap("m.jsonl", [{"iteration": 5}], 10)  # the record of 10 was torn
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "ends at iteration 5" in err and "6-10 are lost" in err
 
 
 def test_a_full_disk_is_one_line_exit_3_and_keeps_the_last_whole_checkpoint(tmp_path, capsys, monkeypatch):
