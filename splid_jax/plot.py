@@ -21,6 +21,7 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg
 
 from splid_jax.cli import Parser
+from splid_jax.learners import registry
 from splid_jax.runtime import progress
 
 DESCRIPTION = (
@@ -119,7 +120,9 @@ def labels(runs: Sequence[Run]) -> tuple[list[str], list[str]]:
             group.append(_dir_name(run))
             continue
         parts = [str(c["env"])]
-        if "select" in c:
+        algo = str(c.get("algo", "splid"))
+        selects = algo not in registry.LEARNERS or registry.reads(algo, "select")  # HER, ES and GCSL do not
+        if "select" in c and selects:
             parts.append(_fmt("select", c["select"]))
         parts += [_fmt(k, c.get(k)) for k in varying]
         group.append(" ".join(parts))

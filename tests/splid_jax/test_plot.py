@@ -85,6 +85,11 @@ def test_labels_and_groups(tmp_path):
     assert group[0] == group[1] != group[2]
 
 
+def test_a_learner_without_select_is_not_labelled_select(tmp_path):
+    runs = [plot.load_run(make_run(tmp_path, name, 0, algo=name)) for name in ("her", "splid")]
+    assert plot.labels(runs)[0] == ["point algo=her s0", "point select algo=splid s0"]
+
+
 def test_group_mean_and_band(tmp_path):
     dirs = [make_run(tmp_path, f"s{s}", s, n=8 + s) for s in range(3)]  # unequal lengths: common evals only
     runs = [plot.load_run(d) for d in dirs]
