@@ -46,7 +46,7 @@ from splid_jax.runtime.run_files import (
     write_atomic,
     write_json,
 )
-from splid_jax.runtime.signals import Interrupted, Signals
+from splid_jax.runtime.signals import Interrupted, SaveAbandoned, Signals
 
 COUNTER_KEYS = ("iteration", "episodes", "env_steps", "select_steps")
 
@@ -299,7 +299,14 @@ class _Loop:
         meta = {**self.meta(), "wall_s": wall_s, "select_steps": select_steps}
         whole = state if self.groups is None else self.groups.join(state)
         if self.writes:
-            checkpoint.save(self.cfg.run_dir, iteration, whole, meta)
+            try:
+                self.signals.finish(lambda: checkpoint.save(self.cfg.run_dir, iteration, whole, meta))
+            except SaveAbandoned as stop:
+                kept = "nothing saved" if self.saved_at is None else f"iteration {self.saved_at} is kept"
+                self.show(f"interrupted ({signal.Signals(stop.signum).name}) while saving iteration {iteration}, "
+                          f"not waited for: the last whole checkpoint, {kept}, in {self.cfg.run_dir}")  # fmt: skip
+                stop.reported = True
+                raise
         multihost.barrier("checkpoint saved")  # before a stop lets any process exit
         self.saved_at = iteration
 
@@ -351,6 +358,8 @@ class _Loop:
                 if iteration == cfg.iterations or (cfg.checkpoint_every and chunks % cfg.checkpoint_every == 0):
                     self.save(state, iteration, select_steps, wall())
                 self.signals.agree()
+        except SaveAbandoned:
+            raise
         except Interrupted as stop:
             self.save(state, iteration, select_steps, wall())
             name = signal.Signals(stop.signum).name
