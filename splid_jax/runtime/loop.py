@@ -180,6 +180,9 @@ class _Loop:
             return multihost.from_first(
                 lambda: [(read_metrics(os.path.join(m.run_dir, METRICS)) or [{}])[-1] for m in self.lanes]
             )
+        if resume and step is None:
+            self.show(f"{cfg.run_dir}: stopped before its first checkpoint; starting it again")
+            resume = False
         multihost.from_first(lambda: check_writable(cfg.run_dir))
         self.saved_at = step
         try:

@@ -64,10 +64,10 @@ def test_a_grid_too_large_for_memory_is_refused_before_it_is_stacked(capsys, tmp
         raise AssertionError("stacked before the size check")
 
     monkeypatch.setattr(loop, "_lane_hyper", stack)
-    args = ["--env", "point", "--iterations", "5", "--eval-every", "5", "--seeds", "20000", "--buffer-size", "2000000"]
+    args = ["--env", "point", "--iterations", "5", "--eval-every", "5", "--seeds", "2000", "--buffer-size", "20000000"]
     assert sweep.main([*args, "--run-dir", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "20000 sweep members" in err and "per member" in err
+    assert len(err.splitlines()) == 1 and "2000 sweep members" in err and "per member" in err
     assert not (tmp_path / "x").exists()
 
 

@@ -5,6 +5,7 @@ signal is real."""
 import dataclasses
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -86,6 +87,7 @@ def final_params(run_dir):
         (["--algo", "gcsl", "--select-radius", "0.5"], "select_radius"),
         (["--algo", "pchid", "--gcsl-relabel", "final"], "gcsl_relabel"),
         (["--iterations", str(10**20)], "iterations"),
+        (["--batch-size", "2000000000"], "batch_size=2000000000"),  # the sizes named are the ones given
         (["--env-options", "success_radius=1,success_radius=2"], "env_options"),  # which one was meant?
     ],
 )
@@ -357,6 +359,11 @@ def test_bad_resumes_and_bad_saved_configs_are_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "warning:" in err and "missing or empty" in err and "1-5 are lost" in err
     assert [r["iteration"] for r in stable(run_dir)] == [10]
+    shutil.rmtree(run_dir / "checkpoints")  # as a run stopped before its first save leaves it
+    (run_dir / "metrics.jsonl").write_text("")
+    assert main(["--resume", str(run_dir), "--iterations", "10"]) == 0
+    assert "stopped before its first checkpoint; starting it again" in capsys.readouterr().out
+    assert [r["iteration"] for r in stable(run_dir)] == [5, 10] and checkpoint.latest_step(str(run_dir)) == 10
 
 
 def test_a_torn_record_at_the_checkpoint_is_warned_of(tmp_path, capsys):
