@@ -21,6 +21,7 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg
 
 from splid_jax.cli import Parser
+from splid_jax.common.paths import unreadable
 from splid_jax.learners import registry
 from splid_jax.runtime import progress
 
@@ -62,9 +63,13 @@ class Run:
 
 
 def load_run(run_dir: str) -> Run:
+    path = os.path.join(run_dir, "metrics.jsonl")
+    for where in (run_dir, path):
+        why = unreadable(where)
+        if why:
+            raise PlotError(f"{where}: cannot be read ({why})")
     if not os.path.isdir(run_dir):
         raise PlotError(f"{run_dir}: no such run directory")
-    path = os.path.join(run_dir, "metrics.jsonl")
     if not os.path.isfile(path):
         raise PlotError(f"{path}: no metrics file")
     records = progress.read_metrics(path, PlotError)

@@ -17,6 +17,7 @@ import numpy as np
 from envs.base import step_batch
 from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache
 from splid_jax.common.errors import InvalidConfig
+from splid_jax.common.paths import unreadable
 from splid_jax.config import TrainConfig
 from splid_jax.learners.registry import make_algorithm
 from splid_jax.runtime import checkpoint
@@ -37,6 +38,9 @@ class RenderingUnavailable(RuntimeError):
 
 def load_config(run_dir: str) -> TrainConfig:
     path = os.path.join(run_dir, "config.json")
+    why = unreadable(run_dir) or unreadable(path)
+    if why:
+        raise InvalidConfig("run_dir", run_dir, f"a run directory whose config.json can be read ({why})")
     if not os.path.isfile(path):
         raise InvalidConfig("run_dir", run_dir, "a run directory holding config.json")
     try:

@@ -14,6 +14,7 @@ if __name__ == "__main__":  # a signal while JAX loads ends the process with one
     quiet_interrupts()
 
 import dataclasses  # noqa: E402
+import errno  # noqa: E402
 import itertools  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
@@ -144,8 +145,9 @@ def resume_configs(run_dir: str, given: dict) -> tuple[TrainConfig, list[TrainCo
         lanes = [
             TrainConfig(**{**m, **given, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in saved["members"]
         ]
-    except (OSError, json.JSONDecodeError, KeyError, TypeError):
-        raise InvalidConfig("resume", run_dir, f"a sweep directory holding its {run_files.SWEEP}") from None
+    except (OSError, json.JSONDecodeError, KeyError, TypeError) as e:
+        why = f" that can be read ({e.strerror})" if isinstance(e, OSError) and e.errno != errno.ENOENT else ""
+        raise InvalidConfig("resume", run_dir, f"a sweep directory holding its {run_files.SWEEP}{why}") from None
     return base, lanes
 
 

@@ -263,3 +263,14 @@ def test_rollout_help_explains_run_dir_and_seed(capsys):
         rollout.main(["--help"])
     out = " ".join(capsys.readouterr().out.split())
     assert "RUN_DIR a run directory written by train" in out and "seed of the episodes' starts" in out
+
+
+def test_rollout_of_an_unreadable_run_is_not_called_missing(tmp_path, capsys, monkeypatch):
+    import os
+
+    (tmp_path / "config.json").write_text("{}")
+    real_access = os.access  # permissions that bar even root, as a read-only share does for others
+    monkeypatch.setattr(os, "access", lambda p, m: not str(p).endswith("config.json") and real_access(p, m))
+    assert rollout.main([str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "whose config.json can be read (Permission denied)" in err

@@ -366,6 +366,15 @@ def test_bad_resumes_and_bad_saved_configs_are_one_line(tmp_path, capsys):
     assert [r["iteration"] for r in stable(run_dir)] == [5, 10] and checkpoint.latest_step(str(run_dir)) == 10
 
 
+def test_an_unreadable_run_is_not_called_missing(tmp_path, capsys, monkeypatch):
+    (tmp_path / "config.json").write_text("{}")
+    real_access = os.access  # permissions that bar even root, as a read-only share does for others
+    monkeypatch.setattr(os, "access", lambda p, m: not str(p).endswith("config.json") and real_access(p, m))
+    assert main(["--resume", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "whose config.json can be read (Permission denied)" in err
+
+
 def test_a_torn_record_at_the_checkpoint_is_warned_of(tmp_path, capsys):
     from splid_jax.runtime.loop import warn_of_gap
 
