@@ -387,3 +387,15 @@ def test_a_merged_sweep_resumes_each_part_with_its_own_shapes(tmp_path, monkeypa
     assert figures.main(["fig4", "--merge", *map(str, parts), "--out", str(out), "--quiet"]) == 0
     assert figures.main(["fig4", "--resume", "--out", str(out), "--quiet"]) == 0
     assert calls == [(str(out / "splid" / "part0"), 16, [16], 2), (str(out / "splid" / "part1"), 4, [2, 4], 4)]
+
+
+def test_a_full_disk_is_one_line_and_exit_3(tmp_path, capsys, monkeypatch):
+    import errno
+
+    def full(path, obj):
+        raise OSError(errno.ENOSPC, "No space left on device", path)
+
+    monkeypatch.setattr(figures.loop, "write_json", full)
+    assert figures.main(["fig3", "--methods", "splid", "--out", str(tmp_path / "out"), *QUICK]) == 3
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "no space left" in err and "figure.json" in err
