@@ -300,16 +300,20 @@ class _Loop:
         if self.saved_at == iteration:
             return
         meta = {**self.meta(), "wall_s": wall_s, "select_steps": select_steps}
-        whole = state if self.groups is None else self.groups.join(state)
-        if self.writes:
-            try:
-                self.signals.finish(lambda: checkpoint.save(self.cfg.run_dir, iteration, whole, meta))
-            except SaveAbandoned as stop:
-                kept = "nothing saved" if self.saved_at is None else f"iteration {self.saved_at} is kept"
-                self.show(f"interrupted ({signal.Signals(stop.signum).name}) while saving iteration {iteration}, "
-                          f"not waited for: the last whole checkpoint, {kept}, in {self.cfg.run_dir}")  # fmt: skip
-                stop.reported = True
-                raise
+
+        def write():  # the join too: it reads the devices' arrays, which a stuck program may never free
+            whole = state if self.groups is None else self.groups.join(state)
+            if self.writes:
+                checkpoint.save(self.cfg.run_dir, iteration, whole, meta)
+
+        try:
+            self.signals.finish(write)
+        except SaveAbandoned as stop:
+            kept = "nothing saved" if self.saved_at is None else f"iteration {self.saved_at} is kept"
+            self.show(f"interrupted ({signal.Signals(stop.signum).name}) while saving iteration {iteration}, "
+                      f"not waited for: the last whole checkpoint, {kept}, in {self.cfg.run_dir}")  # fmt: skip
+            stop.reported = True
+            raise
         multihost.barrier("checkpoint saved")  # before a stop lets any process exit
         self.saved_at = iteration
 
