@@ -33,6 +33,10 @@ class Parser(argparse.ArgumentParser):
     def __init__(self, **kw):
         super().__init__(allow_abbrev=False, **kw)
 
+    def error(self, message: str):
+        """The mistake in one line and where the usage is, not the whole usage before it."""
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
     def format_help(self) -> str:
         listings = {"env_options": task_fields, **learner_option_fields()}
         for action in self._actions:

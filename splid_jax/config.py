@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 import os
 from typing import Any
 
@@ -18,8 +19,34 @@ from splid_jax.common.fields import field
 from splid_jax.common.values import parse_overrides
 from splid_jax.learners import registry
 
+MAX_ITERATIONS = 10**7  # far beyond any run's budget: a larger value is a typo, and would run for ever
 # Keys a run's config.json holds beside the fields: where it ran, not how to run it.
 PROVENANCE = ("devices",)
+
+
+_KINDS = {
+    "int": "an integer",
+    "float": "a number",
+    "bool": "true or false",
+    "str": "a string",
+    "str | None": "a string",
+    "tuple[int, ...]": "a list of integers",
+}
+
+
+def _is_a(value: Any, kind: str) -> bool:
+    """Whether ``value`` is of the field type named ``kind`` (a bool is no number here)."""
+    if isinstance(value, bool):
+        return kind == "bool"
+    if kind == "int":
+        return isinstance(value, numbers.Integral)
+    if kind == "float":
+        return isinstance(value, numbers.Real)
+    if kind in ("str", "str | None"):
+        return isinstance(value, str)
+    if kind == "tuple[int, ...]":
+        return isinstance(value, list | tuple) and all(_is_a(v, "int") for v in value)
+    return True
 
 
 @dataclasses.dataclass(frozen=True)
@@ -103,6 +130,9 @@ class TrainConfig:
     es_options: str = field("", "es only: ES's settings as KEY=VALUE[,KEY=VALUE...], e.g. population=512,sigma=0.05")
 
     def __post_init__(self):
+        for f in dataclasses.fields(self):  # a config.json may hold any JSON: each value's type first
+            value = getattr(self, f.name)
+            check(value is None or _is_a(value, f.type), f.name, value, _KINDS.get(f.type, f.type))
         check(self.env in envs.names(), "env", self.env, "one of " + ", ".join(envs.names()))
         learner = registry.get(self.algo)
         for other in registry.LEARNERS.values():  # each learner's own settings, refused for another
@@ -130,7 +160,8 @@ class TrainConfig:
                 check(math.isfinite(getattr(self, f.name)), f.name, getattr(self, f.name), "a finite number")
             if f.type == "bool":  # a string such as "False" would pass every truth test
                 check(isinstance(getattr(self, f.name), bool), f.name, getattr(self, f.name), "true or false")
-        check(self.iterations >= 1, "iterations", self.iterations, "an integer >= 1")
+        in_range = 1 <= self.iterations <= MAX_ITERATIONS
+        check(in_range, "iterations", self.iterations, f"an integer in [1, {MAX_ITERATIONS}]")
         check(self.num_envs >= 1, "num_envs", self.num_envs, "an integer >= 1")
         check(self.num_devices >= 0, "num_devices", self.num_devices, "an integer >= 0 (0: every device)")
         check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "hidden", self.hidden, "one or more widths >= 1")
@@ -149,6 +180,7 @@ class TrainConfig:
         check(self.checkpoint_every >= 0, "checkpoint_every", self.checkpoint_every, "an integer >= 0")
         if self.run_dir is None:
             object.__setattr__(self, "run_dir", os.path.join("runs", f"{self.env}-s{self.seed}"))
+        check(self.run_dir.strip() != "", "run_dir", self.run_dir, "a directory name, not empty")
         check(not os.path.isfile(self.run_dir), "run_dir", self.run_dir, "a directory, not an existing file")
         self.env_overrides()  # the syntax; the fields themselves are checked where the task is built
 

@@ -20,8 +20,11 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg
 
+from splid_jax.cli import Parser
 from splid_jax.common import stats
+from splid_jax.common.paths import unreadable
 from splid_jax.common.stats import smooth
+from splid_jax.learners import registry
 from splid_jax.runtime import progress
 
 DESCRIPTION = (
@@ -62,9 +65,13 @@ class Run:
 
 
 def load_run(run_dir: str) -> Run:
+    path = os.path.join(run_dir, "metrics.jsonl")
+    for where in (run_dir, path):
+        why = unreadable(where)
+        if why:
+            raise PlotError(f"{where}: cannot be read ({why})")
     if not os.path.isdir(run_dir):
         raise PlotError(f"{run_dir}: no such run directory")
-    path = os.path.join(run_dir, "metrics.jsonl")
     if not os.path.isfile(path):
         raise PlotError(f"{path}: no metrics file")
     records = progress.read_metrics(path, PlotError)
@@ -120,7 +127,9 @@ def labels(runs: Sequence[Run]) -> tuple[list[str], list[str]]:
             group.append(_dir_name(run))
             continue
         parts = [str(c["env"])]
-        if "select" in c:
+        algo = str(c.get("algo", "splid"))
+        selects = algo not in registry.LEARNERS or registry.reads(algo, "select")  # HER, ES and GCSL do not
+        if "select" in c and selects:
             parts.append(_fmt("select", c["select"]))
         parts += [_fmt(k, c.get(k)) for k in varying]
         group.append(" ".join(parts))
@@ -227,7 +236,7 @@ def _positive_int(text: str) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m splid_jax.plot", description=DESCRIPTION, allow_abbrev=False)
+    parser = Parser(prog="python -m splid_jax.plot", description=DESCRIPTION)
     parser.add_argument("run_dirs", nargs="+", metavar="RUN_DIR", help="run directory with metrics.jsonl")
     parser.add_argument("--out", metavar="FILE.png", help="output image (default: RUN_DIR/curves.png of the first)")
     parser.add_argument("--smooth", type=_positive_int, default=1, metavar="K", help="trailing mean over K evals")

@@ -15,12 +15,14 @@ import jax.numpy as jnp
 import numpy as np
 
 from envs.base import step_batch
-from splid_jax.cli import add_compile_cache_flag, use_compile_cache
+from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache
 from splid_jax.common.errors import InvalidConfig
+from splid_jax.common.paths import unreadable
 from splid_jax.config import TrainConfig
 from splid_jax.learners.registry import make_algorithm
 from splid_jax.runtime import checkpoint
 from splid_jax.runtime.loop import make_env
+from splid_jax.runtime.memory import device_memory, gigabytes, nbytes
 from splid_jax.runtime.run_files import env_settings
 
 DESCRIPTION = (
@@ -36,6 +38,9 @@ class RenderingUnavailable(RuntimeError):
 
 def load_config(run_dir: str) -> TrainConfig:
     path = os.path.join(run_dir, "config.json")
+    why = unreadable(run_dir) or unreadable(path)
+    if why:
+        raise InvalidConfig("run_dir", run_dir, f"a run directory whose config.json can be read ({why})")
     if not os.path.isfile(path):
         raise InvalidConfig("run_dir", run_dir, "a run directory holding config.json")
     try:
@@ -186,12 +191,40 @@ def _check_out(out: str) -> None:
         raise InvalidConfig("out", out, "a file in an existing, writable directory")
 
 
+def _check_folder_writable(path: str) -> None:
+    """A file made and removed beside ``path``: a read-only run directory fails here, not after the rollout."""
+    probe = os.path.join(os.path.dirname(path) or ".", f".write-test-{os.getpid()}")
+    try:
+        with open(probe, "w") as fh:
+            fh.write("x")
+        os.remove(probe)
+    except OSError as e:
+        allowed = f"a file in a writable directory ({e.strerror}; pass --out elsewhere)"
+        raise InvalidConfig("out", path, allowed) from None
+
+
+def check_fits(env, episodes: int, device=None) -> None:
+    """The episodes' states, [T + 1, E] twice (the scan's and their concatenation), against the
+    device's memory: too many episodes are refused with the most that fit."""
+    per = sum(nbytes(x) for x in jax.tree.leaves(jax.eval_shape(env.reset, jax.random.PRNGKey(0))))
+    per_episode = 2 * per * (env.episode_length + 1)
+    limit, source = device_memory(device or jax.devices()[0])
+    if episodes * per_episode > limit:
+        need = gigabytes(episodes * per_episode)
+        allowed = f"at most {limit // per_episode} here (they need {need}; {source} is {gigabytes(limit)})"
+        raise InvalidConfig("episodes", episodes, allowed)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m splid_jax.rollout", description=DESCRIPTION, allow_abbrev=False)
-    p.add_argument("run_dir", metavar="RUN_DIR")
+    p = Parser(prog="python -m splid_jax.rollout", description=DESCRIPTION)
+    p.add_argument(
+        "run_dir", metavar="RUN_DIR", help="a run directory written by train (or a sweep's member directory)"
+    )
     p.add_argument("--step", type=int, default=None, help="checkpoint (iteration) to load (default: the newest)")
     p.add_argument("--episodes", type=int, default=16, help="episodes to roll out (default: 16)")
-    p.add_argument("--seed", type=int, default=123, help="seed of the episodes' starts and goals")
+    p.add_argument(
+        "--seed", type=int, default=123, help="seed of the episodes' starts and goals, in [0, 2**32) (default: 123)"
+    )
     p.add_argument(
         "--out",
         default=None,
@@ -213,11 +246,15 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if a.episodes < 1:
             raise InvalidConfig("episodes", a.episodes, "an integer >= 1")
+        if not 0 <= a.seed < 2**32:
+            raise InvalidConfig("seed", a.seed, "an integer in [0, 2**32)")
         if a.out is not None:
             _check_out(a.out)
         cfg = load_config(a.run_dir)
         env, trainer, state, step = load_policy(cfg, a.step)
         figure, frames_out = _outputs(a.out or os.path.join(a.run_dir, f"rollout-{step}.png"), video)
+        check_fits(env, a.episodes)
+        _check_folder_writable(figure)
         mujoco_task = hasattr(env, "mj_model")
         for path in (figure, frames_out) if mujoco_task else (figure,):
             if os.path.exists(path) and not a.overwrite:

@@ -14,6 +14,7 @@ if __name__ == "__main__":  # a signal while JAX loads ends the process with one
     quiet_interrupts()
 
 import dataclasses  # noqa: E402
+import errno  # noqa: E402
 import itertools  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
@@ -61,6 +62,8 @@ def members(seeds: int, sigmas: tuple[float, ...], horizons: tuple[int, ...], ba
     ok = len(sigmas) >= 1 and all(math.isfinite(s) and s >= 0 for s in sigmas)
     check(ok, "sigmas", sigmas, "one or more finite values >= 0")
     check(len(horizons) >= 1 and min(horizons) >= 1, "horizons", horizons, "one or more integers >= 1")
+    for name, values in (("sigmas", sigmas), ("horizons", horizons)):  # two members would share one directory
+        check(len(set(values)) == len(values), name, ",".join(map(str, values)), "distinct values")
     return [Member(base_seed + s, float(sg), int(h)) for sg, h, s in itertools.product(sigmas, horizons, range(seeds))]
 
 
@@ -118,9 +121,9 @@ def build_parser() -> Parser:
     add_config_flags(
         parser, TrainConfig, TASK_DEFAULTS, exclude=frozenset({"sigma", "horizon"}), per_algo=registry.task_defaults()
     )
-    parser.add_argument("--seeds", type=int, default=4, help="seeds per grid point (default: 4)")
-    parser.add_argument("--sigmas", default="1.0", help="comma-separated sigma values (default: 1.0)")
-    parser.add_argument("--horizons", default="8", help="comma-separated H values (default: 8)")
+    parser.add_argument("--seeds", type=int, default=None, help="seeds per grid point (default: 4)")
+    parser.add_argument("--sigmas", default=None, help="comma-separated sigma values (default: 1.0)")
+    parser.add_argument("--horizons", default=None, help="comma-separated H values (default: 8)")
     parser.add_argument("--resume", metavar="RUN_DIR", help="continue the sweep saved in RUN_DIR (its sweep.json)")
     parser.add_argument("--no-plot", action="store_true", help="skip the grid figure")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
@@ -142,9 +145,22 @@ def resume_configs(run_dir: str, given: dict) -> tuple[TrainConfig, list[TrainCo
         lanes = [
             TrainConfig(**{**m, **given, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in saved["members"]
         ]
-    except (OSError, json.JSONDecodeError, KeyError, TypeError):
-        raise InvalidConfig("resume", run_dir, f"a sweep directory holding its {run_files.SWEEP}") from None
+    except (OSError, json.JSONDecodeError, KeyError, TypeError) as e:
+        why = f" that can be read ({e.strerror})" if isinstance(e, OSError) and e.errno != errno.ENOENT else ""
+        raise InvalidConfig("resume", run_dir, f"a sweep directory holding its {run_files.SWEEP}{why}") from None
     return base, lanes
+
+
+def check_same_grid(lanes: list[TrainConfig], seeds: int | None, sigmas: str | None, horizons: str | None) -> None:
+    """A resumed sweep trains the grid it started with: a grid flag given anew must name that grid."""
+    first = {"seeds": len({m.seed for m in lanes}), "sigmas": tuple(dict.fromkeys(m.sigma for m in lanes)),
+             "horizons": tuple(dict.fromkeys(m.horizon for m in lanes))}  # fmt: skip
+    given = {"seeds": seeds, "sigmas": None if sigmas is None else _values("sigmas", sigmas, float),
+             "horizons": None if horizons is None else _values("horizons", horizons, int)}  # fmt: skip
+    for name, value in given.items():
+        if value is not None and value != first[name]:
+            shown = ",".join(map(str, first[name])) if isinstance(first[name], tuple) else first[name]
+            raise InvalidConfig(name, value, f"{shown} as in the sweep being resumed (only iterations may change)")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -156,11 +172,18 @@ def main(argv: list[str] | None = None) -> int:
         given = explicit_values(TrainConfig, ns)
         if ns.resume:  # its sweep.json: process 0's
             cfg, lanes = multihost.from_first(lambda: resume_configs(ns.resume, given))
+            check_same_grid(lanes, ns.seeds, ns.sigmas, ns.horizons)
         else:
-            refuse_unread(given, given.get("algo", "splid"))
+            algo = given.get("algo", "splid")
+            refuse_unread(given, algo)
+            for name, field in (("sigmas", "sigma"), ("horizons", "horizon")):
+                check(getattr(ns, name) is None or registry.reads(algo, field), name, getattr(ns, name),
+                      f"unset with --algo {algo}, which does not read {field}")  # fmt: skip
             given.setdefault("run_dir", os.path.join("runs", f"sweep-{given.get('env', 'point')}"))
-            sigmas, horizons = _values("sigmas", ns.sigmas, float), _values("horizons", ns.horizons, int)
-            grid = members(ns.seeds, sigmas, horizons, base_seed=given.get("seed", 0))
+            sigmas = _values("sigmas", "1.0" if ns.sigmas is None else ns.sigmas, float)
+            horizons = _values("horizons", "8" if ns.horizons is None else ns.horizons, int)
+            seeds = 4 if ns.seeds is None else ns.seeds
+            grid = members(seeds, sigmas, horizons, base_seed=given.get("seed", 0))
             cfg, lanes = member_configs(TrainConfig(**{**given, "horizon": max(horizons), "sigma": max(sigmas)}), grid)
         env = make_env(cfg.env, **cfg.env_overrides())
         cfg.check_env(env)

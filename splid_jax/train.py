@@ -29,6 +29,7 @@ from splid_jax.cli import (  # noqa: E402
     use_compile_cache,
 )
 from splid_jax.common.errors import InvalidConfig  # noqa: E402
+from splid_jax.common.paths import unreadable  # noqa: E402
 from splid_jax.config import PROVENANCE, TASK_DEFAULTS, TrainConfig  # noqa: E402
 from splid_jax.learners import registry  # noqa: E402
 from splid_jax.runtime import checkpoint, loop, multihost, progress  # noqa: E402
@@ -86,7 +87,15 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
     if ns.resume is None:
         refuse_unread(given, given.get("algo", "splid"))
         return TrainConfig(**given), False
+    if not ns.resume.strip():
+        raise InvalidConfig("resume", ns.resume, "a run directory holding config.json")
+    if given.get("run_dir", ns.resume) != ns.resume:  # the run continues where its checkpoints are
+        raise InvalidConfig("run_dir", given["run_dir"], f"unset with --resume (the run continues in {ns.resume})")
+    given.pop("run_dir", None)
     path = os.path.join(ns.resume, "config.json")
+    why = unreadable(ns.resume) or unreadable(path)
+    if why:
+        raise InvalidConfig("resume", ns.resume, f"a run directory whose config.json can be read ({why})")
     if not os.path.isfile(path):
         raise InvalidConfig("resume", ns.resume, "a run directory holding config.json")
     names = {f.name for f in dataclasses.fields(TrainConfig)}

@@ -18,6 +18,8 @@ def parse_overrides(text: str, field: str = "env_options") -> dict:
         key, sep, value = (x.strip() for x in part.partition("="))
         if not sep or not key or not value:
             raise InvalidConfig(field, text, "KEY=VALUE[,KEY=VALUE...] with task fields as keys")
+        if key in overrides:  # which of the two was meant is the user's to say
+            raise InvalidConfig(field, text, f"KEY=VALUE items with each key once ({key} is given twice)")
         overrides[key] = read_value(value)
     return overrides
 
@@ -74,8 +76,9 @@ def parse_options(cls, text: str, field: str, prefix: str):
             items.append(part)
     try:
         overrides = parse_overrides(",".join(items), field)
-    except InvalidConfig:
-        raise InvalidConfig(field, text, f"KEY=VALUE[,KEY=VALUE...] with {prefix} fields as keys") from None
+    except InvalidConfig as e:
+        twice = e.allowed if "twice" in e.allowed else ""
+        raise InvalidConfig(field, text, twice or f"KEY=VALUE[,KEY=VALUE...] with {prefix} fields as keys") from None
     return cls(**typed_fields(cls, overrides, prefix))
 
 

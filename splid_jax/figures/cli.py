@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import datetime
+import io
 import os
 import shlex
 import sys
@@ -19,7 +21,7 @@ from splid_jax.figures.record import check_out, load_record
 from splid_jax.figures.registry import METHODS, SPECS
 from splid_jax.figures.runs import train
 from splid_jax.figures.settings import parse_methods, parse_sets, parse_values
-from splid_jax.runtime import checkpoint, loop, progress
+from splid_jax.runtime import checkpoint, lock, loop, progress
 
 HELP = """\
 fig3: SPLID, GCSL, PCHID, HER, ES and SPLID without SELECT, success at any step and at the final step
@@ -59,7 +61,7 @@ def build_parser() -> Parser:
     parser.add_argument(
         "--methods", default=None, help="fig3: a comma-separated subset of " + ", ".join(METHODS) + " (default: all)"
     )
-    parser.add_argument("--seeds", type=int, default=5, help="seeds per method or setting (default: 5)")
+    parser.add_argument("--seeds", type=int, default=None, help="seeds per method or setting (default: 5)")
     parser.add_argument(
         "--episodes",
         type=int,
@@ -119,43 +121,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     use_compile_cache(ns.compile_cache)
     try:
-        if ns.merge:
-            check(not (ns.replot or ns.resume), "merge", " ".join(ns.merge), "given without --replot or --resume")
-            check(ns.out is not None, "out", None, "the new directory --merge joins the parts into")
-            merge(out, ns.merge, ns.figure, shlex.join(["python", "-m", "splid_jax.figures", *argv]))
-        elif ns.replot or ns.resume:
-            check(not (ns.replot and ns.resume), "replot", True, "given without --resume")
-            if ns.resume:
-                train(out, load_record(out), ns.quiet, resume=True)
-        else:
-            check(env_name in envs.names(), "env", env_name, "one of " + ", ".join(envs.names()))
-            check(not ns.quick or env_name == "point", "env", env_name, "point with --quick")
-            if ns.methods is None:
-                methods = spec.methods
+        with lock.hold(out, field="out"):  # one process per figure directory
+            if ns.merge:
+                check(not (ns.replot or ns.resume), "merge", " ".join(ns.merge), "given without --replot or --resume")
+                check(ns.out is not None, "out", None, "the new directory --merge joins the parts into")
+                merge(out, ns.merge, ns.figure, shlex.join(["python", "-m", "splid_jax.figures", *argv]))
+            elif ns.replot or ns.resume:
+                check(not (ns.replot and ns.resume), "replot", True, "given without --resume")
+                mode = "resume" if ns.resume else "replot"
+                record = check_unchanged(ns, load_record(out, mode), out, mode)
+                if ns.resume:
+                    train(out, record, ns.quiet, resume=True)
             else:
-                check(ns.figure == "fig3", "methods", ns.methods, "given only for fig3")
-                methods = parse_methods(ns.methods, spec.methods)
-            budget = ns.episodes
-            if budget is None:
-                budget = QUICK_EPISODES if ns.quick else default_budget(env_name)
-            sets = parse_sets(ns.set, methods)
-            values = parse_values(spec, ns.values)
-            check_out(out)
-            plans = plan(spec, env_name, methods, ns.seeds, budget, sets, out, values, ns.quick)
-            record = {
-                "figure": ns.figure,
-                "env": env_name,
-                "methods": list(methods),
-                "seeds": ns.seeds,
-                "budget_episodes": budget,
-                "device": device_name(),
-                "date": today,
-                "command": shlex.join(["python", "-m", "splid_jax.figures", *argv]),
-                "runs": describe(plans),
-            }
-            os.makedirs(out, exist_ok=True)
-            train(out, record, ns.quiet)
-        png, table = render(out, ns.quiet)
+                train(out, new_record(ns, spec, env_name, out, today, argv), ns.quiet)
+            png, table = render(out, ns.quiet)
     except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 2
@@ -165,5 +144,58 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (loop.RunStopped, checkpoint.CheckpointError) as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 3
+    except OSError as err:  # a file of the figure's own (figure.json, the PNG) on a full disk
+        if not checkpoint.is_no_space(err):
+            raise
+        print(f"{parser.prog}: error: no space left on the device ({err.filename or out})", file=sys.stderr)
+        return 3
     progress.show(f"figure: {png}\ntable: {table}", ns.quiet)
     return 0
+
+
+def new_record(ns: argparse.Namespace, spec, env_name: str, out: str, today: str, argv: list[str]) -> dict:
+    """OUT/figure.json of a new figure, after its settings are checked; OUT is made, still empty."""
+    check(env_name in envs.names(), "env", env_name, "one of " + ", ".join(envs.names()))
+    check(not ns.quick or env_name == "point", "env", env_name, "point with --quick")
+    if ns.methods is None:
+        methods = spec.methods
+    else:
+        check(ns.figure == "fig3", "methods", ns.methods, "given only for fig3")
+        methods = parse_methods(ns.methods, spec.methods)
+    budget = ns.episodes
+    if budget is None:
+        budget = QUICK_EPISODES if ns.quick else default_budget(env_name)
+    sets = parse_sets(ns.set, methods)
+    values = parse_values(spec, ns.values)
+    check_out(out)
+    seeds = 5 if ns.seeds is None else ns.seeds
+    plans = plan(spec, env_name, methods, seeds, budget, sets, out, values, ns.quick)
+    os.makedirs(out, exist_ok=True)
+    return {
+        "figure": ns.figure,
+        "env": env_name,
+        "methods": list(methods),
+        "seeds": seeds,
+        "budget_episodes": budget,
+        "device": device_name(),
+        "date": today,
+        "command": shlex.join(["python", "-m", "splid_jax.figures", *argv]),
+        "runs": describe(plans),
+    }
+
+
+def check_unchanged(ns: argparse.Namespace, record: dict, out: str, mode: str) -> dict:
+    """``record`` if the command asks for the figure it holds: --resume and --replot continue or redraw
+    a figure as it was started, so a setting given anew must be the one it was started with."""
+    check(ns.figure == record["figure"], "figure", ns.figure, f"{record['figure']}, the figure in {out}")
+    started = {"env": record.get("env"), "seeds": record.get("seeds"), "episodes": record.get("budget_episodes")}
+    with contextlib.suppress(SystemExit, ValueError, TypeError, KeyError), contextlib.redirect_stderr(io.StringIO()):
+        first = build_parser().parse_args(shlex.split(record["command"])[3:])
+        started |= {"set": first.set, "values": first.values, "methods": first.methods, "quick": first.quick}
+    for name in ("env", "methods", "seeds", "episodes", "values", "set", "quick"):
+        given, default = getattr(ns, name), build_parser().get_default(name)
+        if given != default and given != started.get(name, default):
+            was = started.get(name)
+            allowed = f"{was!r} as the figure in {out} was started (--{mode} changes no setting)"
+            raise InvalidConfig(name, given, allowed)
+    return record

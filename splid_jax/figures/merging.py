@@ -19,7 +19,7 @@ def merge(out: str, parts: Sequence[str], figure: str, command: str) -> dict:
     copied into ``out`` (checkpoints too, so ``--resume`` continues an unfinished one) and their records
     joined; the parts stay as they are."""
     check(len(parts) >= 2, "merge", " ".join(parts), "two or more figure directories")
-    records = [load_record(p) for p in parts]
+    records = [load_record(p, "merge") for p in parts]
     first, spec = records[0], SPECS[figure]
     check(first["figure"] == figure, "merge", parts[0], f"a {figure} directory")
     for part, record in zip(parts, records, strict=True):

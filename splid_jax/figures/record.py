@@ -8,20 +8,23 @@ import os
 
 from splid_jax.common.errors import InvalidConfig, check
 from splid_jax.figures.registry import SPECS
-from splid_jax.runtime import loop
+from splid_jax.runtime import lock, loop
 
 SPEC = "figure.json"  # the figure's command, device, date and what each method ran
 
 
-def load_record(out: str) -> dict:
+def load_record(out: str, field: str = "out") -> dict:
+    """OUT/figure.json; a missing or unreadable one is blamed on ``field``, the flag that named OUT."""
     path = os.path.join(out, SPEC)
     try:
         with open(path) as fh:
             record = json.load(fh)
-        check(record.get("figure") in SPECS, "replot", out, f"a figure directory ({path} names no figure)")
+        check(isinstance(record, dict) and record.get("figure") in SPECS, field, out,
+              f"a figure directory ({path} names no figure)")  # fmt: skip
         return record
-    except (OSError, json.JSONDecodeError):
-        raise InvalidConfig("replot", out, f"a directory holding the {SPEC} a figure command wrote") from None
+    except (OSError, json.JSONDecodeError) as e:
+        why = "" if isinstance(e, FileNotFoundError | json.JSONDecodeError) else f" ({e.strerror})"
+        raise InvalidConfig(field, out, f"a directory holding the {SPEC} a figure command wrote{why}") from None
 
 
 def sweeps(record: dict) -> list[tuple[str, dict, str]]:
@@ -37,7 +40,7 @@ def sweeps(record: dict) -> list[tuple[str, dict, str]]:
 
 
 def check_out(out: str) -> None:
-    if os.path.isdir(out) and os.listdir(out):
+    if os.path.isdir(out) and set(os.listdir(out)) - {lock.LOCK}:
         raise InvalidConfig("out", out, "a new or empty directory (--replot redraws the figure in it)")
     check(not os.path.exists(out) or os.path.isdir(out), "out", out, "a directory, not a file")
     loop.check_writable(out)

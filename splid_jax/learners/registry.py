@@ -35,8 +35,11 @@ class Learner:
 
 
 IMITATION_FIELDS = tuple(f.name for f in dataclasses.fields(ImitationConfig))
+# SELECT's settings, read by SPLID and PCHID; GCSL clones every relabelled pair and selects nothing
+SELECT_FIELDS = ("horizon", "select", "relabel", "select_radius", "select_lanes")
+_CLONING = tuple(f for f in IMITATION_FIELDS if f not in (*SELECT_FIELDS, "gcsl_relabel", "pchid_every"))
 _TRAINER = "splid_jax.learners.splid.trainer:Trainer"
-_IMITATION = dict(settings=ImitationConfig, reads=IMITATION_FIELDS, splits_envs=True, sweeps=("sigma", "horizon"))
+_IMITATION = dict(settings=ImitationConfig, splits_envs=True, sweeps=("sigma", "horizon"))
 # HER on the Fetch tasks runs as OpenAI Baselines: a cycle explores 2 episodes on each of 8 workers
 # (num_envs 16, with HerConfig's batch of 2048 = 8 x 256 averaged gradients) and an epoch of 50 cycles
 # is evaluated (eval_every 50). Push's 1,250 cycles are 20,000 episodes; Slide's and PickAndPlace's
@@ -46,10 +49,22 @@ _HER_FETCH = dict(num_envs=16, eval_every=50)
 LEARNERS: dict[str, Learner] = {
     learner.name: learner
     for learner in (
-        Learner("splid", "Algorithm 2", _TRAINER, **_IMITATION),
-        Learner("gcsl", "every relabelled pair cloned", _TRAINER, **_IMITATION, clones_every_pair=True),
+        Learner("splid", "Algorithm 2", _TRAINER, reads=(*_CLONING, *SELECT_FIELDS), **_IMITATION),
         Learner(
-            "pchid", "SPLID with the horizon grown 1..H, see --pchid-every", _TRAINER, **_IMITATION, grows_horizon=True
+            "gcsl",
+            "every relabelled pair cloned",
+            _TRAINER,
+            reads=(*_CLONING, "gcsl_relabel"),
+            **_IMITATION,
+            clones_every_pair=True,
+        ),
+        Learner(
+            "pchid",
+            "SPLID with the horizon grown 1..H, see --pchid-every",
+            _TRAINER,
+            reads=(*_CLONING, *SELECT_FIELDS, "pchid_every"),
+            **_IMITATION,
+            grows_horizon=True,
         ),
         Learner(
             "her",

@@ -9,6 +9,7 @@ error, so a CRC32 of every leaf is stored too and checked on restore.
 
 from __future__ import annotations
 
+import errno
 import json
 import math
 import zlib
@@ -28,6 +29,20 @@ _MISSING = object()
 
 class CheckpointError(RuntimeError):
     """A checkpoint is absent, unreadable or does not fit the run resuming from it."""
+
+
+class NoSpace(CheckpointError):
+    """The disk filled up while the run wrote; its last whole checkpoint is kept."""
+
+
+def is_no_space(e: BaseException | None) -> bool:
+    """Whether ``e``, or an error it was raised from, is a full disk (orbax and tensorstore wrap it)."""
+    seen = 0
+    while e is not None and seen < 20:
+        if (isinstance(e, OSError) and e.errno == errno.ENOSPC) or "No space left on device" in str(e):
+            return True
+        e, seen = e.__cause__ or e.__context__, seen + 1
+    return False
 
 
 def checkpoint_dir(run_dir: str | Path) -> Path:

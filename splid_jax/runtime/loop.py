@@ -18,6 +18,7 @@ import io
 import json
 import os
 import signal
+import sys
 import time
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -31,7 +32,7 @@ from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 from splid_jax.learners import registry
 from splid_jax.learners.base import EVAL_KEYS, Algorithm
-from splid_jax.runtime import checkpoint, devices, multihost, progress
+from splid_jax.runtime import checkpoint, devices, lock, multihost, progress
 from splid_jax.runtime.groups import Groups
 from splid_jax.runtime.memory import DoesNotFit, check_memory, compile_hint, gigabytes, largest_value, nbytes, sizes
 from splid_jax.runtime.run_files import (
@@ -45,7 +46,7 @@ from splid_jax.runtime.run_files import (
     write_atomic,
     write_json,
 )
-from splid_jax.runtime.signals import Interrupted, Signals
+from splid_jax.runtime.signals import Interrupted, SaveAbandoned, Signals
 
 COUNTER_KEYS = ("iteration", "episodes", "env_steps", "select_steps")
 
@@ -136,12 +137,22 @@ def run(
     ``members``: the configs of a sweep's members (each its own seed, run_dir and traced settings),
     trained in lock-step as one vmapped program with checkpoints under ``cfg.run_dir``. Over several
     processes every process calls it alike and each returns the records; only process 0 writes and shows."""
-    env = env or make_env(cfg.env, **cfg.env_overrides())
-    place = placement(cfg, None if members is None else len(members), algo)
-    split_envs = place.axis == devices.ENVS and place.count > 1
-    algo = algo or registry.make_algorithm(cfg, env, place.mesh if split_envs else None)
-    with Signals() as signals:
+    with Signals() as signals, lock.hold(cfg.run_dir, multihost.is_first()):
+        env = env or signals.wait(lambda: make_env(cfg.env, **cfg.env_overrides()))
+        place = placement(cfg, None if members is None else len(members), algo)
+        split_envs = place.axis == devices.ENVS and place.count > 1
+        algo = algo or signals.wait(lambda: registry.make_algorithm(cfg, env, place.mesh if split_envs else None))
         return _Loop(cfg, env, algo, members, place, signals, quiet, on_record).run(resume)
+
+
+def warn_of_gap(path: str, kept: list[dict], step: int) -> None:
+    """A metrics file that stops short of its checkpoint (a torn last line, a deleted file) would
+    resume with a gap in its curve: said on stderr, since the records cannot be made again."""
+    last = kept[-1]["iteration"] if kept else 0
+    if last < step:
+        what = "is missing or empty" if not kept else f"ends at iteration {last}"
+        print(f"warning: {path} {what} but the checkpoint is at iteration {step}: the records of iterations "
+              f"{last + 1}-{step} are lost, so its curve has a gap there", file=sys.stderr)  # fmt: skip
 
 
 class _Loop:
@@ -175,6 +186,9 @@ class _Loop:
             return multihost.from_first(
                 lambda: [(read_metrics(os.path.join(m.run_dir, METRICS)) or [{}])[-1] for m in self.lanes]
             )
+        if resume and step is None:
+            self.show(f"{cfg.run_dir}: stopped before its first checkpoint; starting it again")
+            resume = False
         multihost.from_first(lambda: check_writable(cfg.run_dir))
         self.saved_at = step
         try:
@@ -184,20 +198,30 @@ class _Loop:
                 kept = "nothing saved" if step is None else f"the checkpoint at iteration {step} is kept"
                 self.show(f"interrupted ({signal.Signals(stop.signum).name}) before the first chunk ended: {kept}")
             raise
+        except Exception as e:  # a full disk, whichever write met it: one line, the last checkpoint kept
+            if not checkpoint.is_no_space(e):
+                raise
+            kept = "nothing saved" if self.saved_at is None else f"the checkpoint at iteration {self.saved_at} is kept"
+            raise checkpoint.NoSpace(f"no space left on the device writing {cfg.run_dir}: {kept}") from None
 
     def start(self, resume: bool, step: int | None) -> list[dict]:
         cfg, algo = self.cfg, self.algo
 
-        keys = [jax.random.PRNGKey(m.seed) for m in self.lanes]
-        hypers = [_lane_hyper(algo, cfg, m) for m in self.lanes]
-        init, chunk = algo.init, algo.chunk
         place = self.place
-        if self.stacked:
-            keys, hyper = jnp.stack(keys), jax.tree.map(lambda *x: jnp.stack(x), *hypers)
-            init, chunk = jax.vmap(init), jax.vmap(chunk)
-        else:
-            keys, hyper = keys[0], hypers[0]
         split = self.stacked and place.axis == devices.MEMBERS and place.count > 1
+        self.check_state_fits(split)
+
+        def stack():  # seconds for a sweep of thousands of members: a signal must not wait for it
+            keys = [jax.random.PRNGKey(m.seed) for m in self.lanes]
+            hypers = [_lane_hyper(algo, cfg, m) for m in self.lanes]
+            if self.stacked:
+                return jnp.stack(keys), jax.tree.map(lambda *x: jnp.stack(x), *hypers)
+            return keys[0], hypers[0]
+
+        keys, hyper = self.signals.wait(stack)
+        init, chunk = algo.init, algo.chunk
+        if self.stacked:
+            init, chunk = jax.vmap(init), jax.vmap(chunk)
         groups = Groups(place, len(self.lanes)) if split else None
         sharding = place.state_sharding() if groups is None else jax.sharding.SingleDeviceSharding(self.device)
         like = _abstract(jax.eval_shape(init, keys), sharding)  # the whole sweep's, as checkpoints hold it
@@ -250,6 +274,14 @@ class _Loop:
         self.groups = groups
         return self.train(compiled, state, hyper, step or 0, select_steps, wall_before)
 
+    def check_state_fits(self, split: bool) -> None:
+        """One member's state times the members a device holds, twice (the state and its update),
+        against the device's memory: a grid of thousands is refused before anything is stacked or traced."""
+        one = sum(nbytes(x) for x in jax.tree.leaves(jax.eval_shape(self.algo.init, jax.random.PRNGKey(0))))
+        held = -(-len(self.lanes) // self.place.count) if split else len(self.lanes)
+        what = f"state {gigabytes(one)} per member x {held} members, twice" if self.stacked else "state twice"
+        check_memory(2 * one * held, what, self.device, self.cfg, len(self.lanes))
+
     def restore(self, like):
         cfg = self.cfg
 
@@ -258,6 +290,7 @@ class _Loop:
             for lane in self.lanes:  # lines written past the checkpoint are dropped, as is a torn last line
                 path = os.path.join(lane.run_dir, METRICS)
                 kept = [r for r in read_metrics(path) if r["iteration"] <= step]
+                warn_of_gap(path, kept, step)
                 write_atomic(path, "".join(json.dumps(r) + "\n" for r in kept))
             return step, state, meta
 
@@ -273,9 +306,20 @@ class _Loop:
         if self.saved_at == iteration:
             return
         meta = {**self.meta(), "wall_s": wall_s, "select_steps": select_steps}
-        whole = state if self.groups is None else self.groups.join(state)
-        if self.writes:
-            checkpoint.save(self.cfg.run_dir, iteration, whole, meta)
+
+        def write():  # the join too: it reads the devices' arrays, which a stuck program may never free
+            whole = state if self.groups is None else self.groups.join(state)
+            if self.writes:
+                checkpoint.save(self.cfg.run_dir, iteration, whole, meta)
+
+        try:
+            self.signals.finish(write)
+        except SaveAbandoned as stop:
+            kept = "nothing saved" if self.saved_at is None else f"iteration {self.saved_at} is kept"
+            self.show(f"interrupted ({signal.Signals(stop.signum).name}) while saving iteration {iteration}, "
+                      f"not waited for: the last whole checkpoint, {kept}, in {self.cfg.run_dir}")  # fmt: skip
+            stop.reported = True
+            raise
         multihost.barrier("checkpoint saved")  # before a stop lets any process exit
         self.saved_at = iteration
 
@@ -329,6 +373,8 @@ class _Loop:
                 if iteration == cfg.iterations or (cfg.checkpoint_every and chunks % cfg.checkpoint_every == 0):
                     self.save(state, iteration, select_steps, wall())
                 self.signals.agree()
+        except SaveAbandoned:
+            raise
         except Interrupted as stop:
             self.save(state, iteration, select_steps, wall())
             name = signal.Signals(stop.signum).name

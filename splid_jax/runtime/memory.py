@@ -10,6 +10,7 @@ import numpy as np
 import envs
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
+from splid_jax.learners import registry
 
 
 class DoesNotFit(InvalidConfig):
@@ -66,7 +67,11 @@ def gigabytes(n: float) -> str:
 
 
 def sizes(cfg: TrainConfig, members: int) -> str:
-    sizes = f"num_envs={cfg.num_envs}, buffer_size={cfg.buffer_size}, eval_episodes={cfg.eval_episodes}"
+    """The settings that size a run's arrays, those of its learner only (HER's are in its options)."""
+    named = [n for n in ("num_envs", "buffer_size", "batch_size") if registry.reads(cfg.algo, n)]
+    sizes = ", ".join(f"{n}={getattr(cfg, n)}" for n in [*named, "eval_episodes"])
+    if registry.get(cfg.algo).options:
+        sizes += f", {registry.get(cfg.algo).options}={getattr(cfg, registry.get(cfg.algo).options)!r}"
     return sizes + (f", {members} sweep members" if members > 1 else "")
 
 
@@ -82,5 +87,7 @@ def check_memory(need: int, what: str, device, cfg: TrainConfig, members: int) -
 def compile_hint(env: envs.GoalEnv) -> str:
     """Roughly how long the first compilation takes for this kind of task."""
     if type(env).__module__.startswith("envs.fetch"):
-        return "about 3 minutes for an MJX task on a 2-core CPU, under a minute on a GPU"
+        return "about 3 minutes for a Fetch task on a 2-core CPU, under a minute on a GPU"
+    if hasattr(type(env), "mj_model"):  # the other MuJoCo (MJX) tasks: a smaller model than Fetch's
+        return "about a minute for an MJX task on a 2-core CPU, less on a GPU"
     return "about 15 s on a 2-core CPU, a few seconds on a GPU"

@@ -50,6 +50,13 @@ def holds_metrics(run_dir: str) -> str | None:
         return None
     if os.path.isfile(os.path.join(run_dir, SWEEP)):
         return os.path.join(run_dir, SWEEP)
+    return recorded(run_dir)
+
+
+def recorded(run_dir: str) -> str | None:
+    """A metrics.jsonl with content in ``run_dir`` or one level below (a sweep's members)."""
+    if not os.path.isdir(run_dir):
+        return None
     candidates = [os.path.join(run_dir, METRICS)]
     candidates += [os.path.join(run_dir, d, METRICS) for d in sorted(os.listdir(run_dir))]
     for path in candidates:
@@ -60,7 +67,8 @@ def holds_metrics(run_dir: str) -> str | None:
 
 def check_run_dir(cfg: TrainConfig, resume: bool) -> int | None:
     """Refuses a run that would overwrite another, or a resume to fewer iterations than done;
-    returns the step a resume starts from."""
+    returns the step a resume starts from, None where the run stopped before its first checkpoint
+    and recorded nothing (it then starts again)."""
     if not resume:
         if os.path.isdir(cfg.run_dir) and checkpoint.latest_step(cfg.run_dir) is not None:
             raise InvalidConfig("run_dir", cfg.run_dir, "a directory without a run in it (or pass --resume RUN_DIR)")
@@ -69,8 +77,15 @@ def check_run_dir(cfg: TrainConfig, resume: bool) -> int | None:
             raise InvalidConfig("run_dir", cfg.run_dir, f"a directory without a run in it (it holds {held})")
         return None
     step = checkpoint.latest_step(cfg.run_dir) if os.path.isdir(cfg.run_dir) else None
-    if step is None:
+    if step is None and not os.path.isfile(os.path.join(cfg.run_dir, "config.json")) and not os.path.isfile(
+        os.path.join(cfg.run_dir, SWEEP)
+    ):
         raise InvalidConfig("resume", cfg.run_dir, "a run directory holding a checkpoint")
+    if step is None:  # stopped before its first save (killed, or a save not waited for): nothing to keep
+        held = recorded(cfg.run_dir)
+        if held is not None:
+            raise InvalidConfig("resume", cfg.run_dir, f"a run directory holding a checkpoint (it holds {held})")
+        return None
     if step > cfg.iterations:
         raise InvalidConfig("iterations", cfg.iterations, f">= {step}, the iterations {cfg.run_dir} has completed")
     return step

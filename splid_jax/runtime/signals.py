@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import signal
 import threading
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -23,6 +24,16 @@ class Interrupted(KeyboardInterrupt):
         self.exit_code = 128 + signum
 
 
+class SaveAbandoned(Interrupted):
+    """A signal came while a checkpoint was written, and the write was not waited for: the last
+    whole checkpoint is the one kept (orbax renames a step into place only once it is complete)."""
+
+
+# Seconds a save may go on after a signal: a state of gigabytes is written in that time, and a
+# save stuck on a full or hung filesystem does not hold the process any longer.
+GRACE_S = 10.0
+
+
 class Signals:
     """SIGINT and SIGTERM only set a flag, read between steps. Blocking work (tracing, compiling, a
     chunk) runs in a daemon thread while the main thread waits in short slices, so a signal is seen
@@ -33,6 +44,7 @@ class Signals:
 
     def __init__(self):
         self.signum: int | None = None
+        self.count = 0  # signals caught: a second one ends a checkpoint save at once
         self.shared = jax.process_count() > 1
         self._previous: dict[int, Any] = {}
 
@@ -47,6 +59,7 @@ class Signals:
             signal.signal(sig, handler)
 
     def _caught(self, signum, frame) -> None:
+        self.count += 1
         if self.signum is None:
             self.signum = signum
 
@@ -66,19 +79,48 @@ class Signals:
         """``fn()`` in a daemon thread; raises ``Interrupted`` as soon as a signal came (the thread is
         left to finish or to die with the process)."""
         self.check()
-        box: dict[str, Any] = {}
-
-        def work():
-            try:
-                box["out"] = fn()
-            except BaseException as e:  # handed to the main thread as is
-                box["err"] = e
-
-        thread = threading.Thread(target=work, name="splid_jax-work", daemon=True)
-        thread.start()
+        thread, box = _started(fn)
         while thread.is_alive():
             thread.join(0.05)
             self.check()
-        if "err" in box:
-            raise box["err"]
-        return box["out"]
+        return _result(box)
+
+    def finish(self, fn: Callable[[], Any], grace: float = GRACE_S) -> Any:
+        """``fn()`` (a checkpoint save) in a daemon thread, which a first signal does not cut short: a
+        signal before or during it leaves it ``grace`` seconds, a further signal none. Past that it
+        raises ``SaveAbandoned``, whatever ``fn`` waits on. Over several processes it is ``fn()``,
+        which every process must reach."""
+        if self.shared:
+            return fn()
+        seen = self.count
+        deadline = time.monotonic() + grace if self.signum is not None else None
+        thread, box = _started(fn)
+        while thread.is_alive():
+            thread.join(0.05)
+            new, seen = self.count - seen, self.count
+            if new and deadline is None:
+                deadline = time.monotonic() + grace
+                new -= 1
+            if new or (deadline is not None and time.monotonic() > deadline):
+                raise SaveAbandoned(self.signum or signal.SIGINT)
+        return _result(box)
+
+
+def _started(fn: Callable[[], Any]) -> tuple[threading.Thread, dict[str, Any]]:
+    box: dict[str, Any] = {}
+
+    def work():
+        try:
+            box["out"] = fn()
+        except BaseException as e:  # handed to the main thread as is
+            box["err"] = e
+
+    thread = threading.Thread(target=work, name="splid_jax-work", daemon=True)
+    thread.start()
+    return thread, box
+
+
+def _result(box: dict[str, Any]) -> Any:
+    if "err" in box:
+        raise box["err"]
+    return box["out"]

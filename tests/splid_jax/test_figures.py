@@ -95,6 +95,9 @@ def test_resume_of_a_finished_figure_trains_nothing_and_redraws_it(fig3):
     runs = {p: p.read_bytes() for p in out.glob("*/*/metrics.jsonl")}
     assert figures.main(["fig3", "--resume", "--out", str(out), "--quiet"]) == 0
     assert {p: p.read_bytes() for p in out.glob("*/*/metrics.jsonl")} == runs
+    started = ["fig3", "--methods", ",".join(TRAINED), "--out", str(out), *QUICK]
+    assert figures.main([*started, "--resume"]) == 0  # the command it was started with, resumed
+    assert {p: p.read_bytes() for p in out.glob("*/*/metrics.jsonl")} == runs
     assert (out / "fig3-point.png").read_bytes()[:8] == PNG_MAGIC
 
 
@@ -121,6 +124,35 @@ def test_a_bad_argument_is_one_line_and_exit_2(capsys, tmp_path, args, field):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
     assert not out.exists()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "args, field",
+    [
+        (["fig3", "--episodes", "12800"], "episodes"),
+        (["fig3", "--seeds", "3"], "seeds"),
+        (["fig3", "--set", "learning_rate=0.01"], "set"),
+        (["fig5"], "figure"),
+        (["fig3", "--methods", "splid"], "methods"),
+    ],
+)
+@pytest.mark.parametrize("mode", ["--resume", "--replot"])
+def test_resume_and_replot_refuse_settings_the_figure_did_not_start_with(fig3, capsys, args, field, mode):
+    code, out = fig3
+    assert code == 0
+    before = {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()}
+    assert figures.main([*args, mode, "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+    assert {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()} == before
+
+
+@pytest.mark.parametrize("mode", ["--resume", "--replot"])
+def test_a_dir_without_a_figure_is_blamed_on_the_flag_that_named_it(capsys, tmp_path, mode):
+    assert figures.main(["fig3", mode, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"invalid {mode[2:]}=" in err and "figure.json" in err
 
 
 def test_replot_of_a_dir_without_a_figure_is_one_line(capsys, tmp_path):
@@ -356,3 +388,15 @@ def test_a_merged_sweep_resumes_each_part_with_its_own_shapes(tmp_path, monkeypa
     assert figures.main(["fig4", "--merge", *map(str, parts), "--out", str(out), "--quiet"]) == 0
     assert figures.main(["fig4", "--resume", "--out", str(out), "--quiet"]) == 0
     assert calls == [(str(out / "splid" / "part0"), 16, [16], 2), (str(out / "splid" / "part1"), 4, [2, 4], 4)]
+
+
+def test_a_full_disk_is_one_line_and_exit_3(tmp_path, capsys, monkeypatch):
+    import errno
+
+    def full(path, obj):
+        raise OSError(errno.ENOSPC, "No space left on device", path)
+
+    monkeypatch.setattr(loop, "write_json", full)
+    assert figures.main(["fig3", "--methods", "splid", "--out", str(tmp_path / "out"), *QUICK]) == 3
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "no space left" in err and "figure.json" in err

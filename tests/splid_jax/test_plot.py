@@ -1,4 +1,5 @@
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -83,6 +84,20 @@ def test_labels_and_groups(tmp_path):
     full, group = plot.labels(runs)
     assert full == ["point select sigma=0.5 s0", "point select sigma=0.5 s1", "point no-select sigma=1.0 s0", "bare"]
     assert group[0] == group[1] != group[2]
+
+
+def test_a_learner_without_select_is_not_labelled_select(tmp_path):
+    runs = [plot.load_run(make_run(tmp_path, name, 0, algo=name)) for name in ("her", "splid")]
+    assert plot.labels(runs)[0] == ["point algo=her s0", "point select algo=splid s0"]
+
+
+def test_an_unreadable_metrics_file_is_not_called_missing(tmp_path, monkeypatch, capsys):
+    run = make_run(tmp_path, "a", 0)
+    real_access = os.access  # permissions that bar even root, as a read-only share does for others
+    monkeypatch.setattr(os, "access", lambda p, m: not str(p).endswith("metrics.jsonl") and real_access(p, m))
+    assert plot.main([str(run), "--out", str(tmp_path / "x.png")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "cannot be read (Permission denied)" in err
 
 
 def test_group_mean_and_band(tmp_path):

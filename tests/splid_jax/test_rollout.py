@@ -226,3 +226,51 @@ def test_rollout_acts_as_the_evaluation_of_a_her_or_es_run(tmp_path, capsys, alg
     assert succ.any(axis=0).mean() == pytest.approx(float(evaluated["eval_success"]))
     assert rollout.main([str(run_dir), "--episodes", "4"]) == 0
     assert "iteration 0" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "args,field",
+    [(["--episodes", "100000000"], "episodes"), (["--seed", "-1"], "seed"), (["--seed", str(2**32)], "seed")],
+)
+def test_rollout_refuses_what_it_cannot_do_before_rolling_out(point_run, capsys, monkeypatch, args, field):
+    monkeypatch.setattr(rollout, "rollout", lambda *a, **kw: pytest.fail("rolled out"))
+    before = _files(point_run)
+    assert rollout.main([str(point_run), *args]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+    assert _files(point_run) == before
+
+
+def test_rollout_of_a_run_in_a_read_only_directory_says_so_before_rolling_out(point_run, capsys, monkeypatch):
+    import builtins
+
+    real_open = builtins.open
+
+    def read_only(path, mode="r", *a, **kw):  # the run directory refuses writes, as a read-only mount does
+        if "w" in mode and str(path).startswith(str(point_run)):
+            raise PermissionError(13, "Permission denied", str(path))
+        return real_open(path, mode, *a, **kw)
+
+    monkeypatch.setattr(builtins, "open", read_only)
+    monkeypatch.setattr(rollout, "rollout", lambda *a, **kw: pytest.fail("rolled out"))
+    assert rollout.main([str(point_run), "--episodes", "4", "--overwrite"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "invalid out=" in err and "writable" in err
+
+
+def test_rollout_help_explains_run_dir_and_seed(capsys):
+    with pytest.raises(SystemExit):
+        rollout.main(["--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert "RUN_DIR a run directory written by train" in out and "seed of the episodes' starts" in out
+
+
+def test_rollout_of_an_unreadable_run_is_not_called_missing(tmp_path, capsys, monkeypatch):
+    import os
+
+    (tmp_path / "config.json").write_text("{}")
+    real_access = os.access  # permissions that bar even root, as a read-only share does for others
+    monkeypatch.setattr(os, "access", lambda p, m: not str(p).endswith("config.json") and real_access(p, m))
+    assert rollout.main([str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "whose config.json can be read (Permission denied)" in err

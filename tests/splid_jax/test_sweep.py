@@ -44,12 +44,30 @@ def test_cli_rejects_a_bad_grid(capsys, tmp_path):
         (["--sigmas", "inf"], "sigmas"),
         (["--horizons", "2.5"], "horizons"),
         (["--seed", "-1"], "seed"),
+        (["--horizons", "4,4"], "horizons"),  # two members would share one directory
+        (["--sigmas", "1,1.0"], "sigmas"),
+        (["--algo", "gcsl", "--horizons", "2,4"], "horizons"),  # GCSL selects nothing: H is not read
+        (["--algo", "her", "--sigmas", "0.5"], "sigmas"),
     ],
 )
 def test_cli_names_the_field_of_a_bad_value(capsys, tmp_path, args, field):
     assert sweep.main(["--env", "point", *args, "--run-dir", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+    assert not (tmp_path / "x").exists()
+
+
+def test_a_grid_too_large_for_memory_is_refused_before_it_is_stacked(capsys, tmp_path, monkeypatch):
+    from splid_jax.runtime import loop
+
+    def stack(*a, **kw):
+        raise AssertionError("stacked before the size check")
+
+    monkeypatch.setattr(loop, "_lane_hyper", stack)
+    args = ["--env", "point", "--iterations", "5", "--eval-every", "5", "--seeds", "2000", "--buffer-size", "20000000"]
+    assert sweep.main([*args, "--run-dir", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "2000 sweep members" in err and "per member" in err
     assert not (tmp_path / "x").exists()
 
 
@@ -70,6 +88,13 @@ def test_a_second_sweep_into_one_dir_is_refused_and_a_sweep_resumes(capsys, tmp_
     assert sweep.main([*args, "--iterations", "4", "--sigmas", "0.5", "--run-dir", run_dir]) == 2
     assert "run_dir" in capsys.readouterr().err
     assert read(tmp_path / "sweep" / "sigma1-H4-s0" / "metrics.jsonl") == kept
-    assert sweep.main(["--resume", run_dir, "--iterations", "4", "--no-plot", "--quiet"]) == 0
+    other_grids = [(["--seeds", "3"], "seeds"), (["--sigmas", "0.5"], "sigmas"), (["--horizons", "2"], "horizons")]
+    for grid, field in other_grids:
+        assert sweep.main(["--resume", run_dir, *grid, "--iterations", "4", "--no-plot", "--quiet"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and f"invalid {field}=" in err and "as in the sweep being resumed" in err
+    assert read(tmp_path / "sweep" / "sigma1-H4-s0" / "metrics.jsonl") == kept
+    same = ["--seeds", "2", "--sigmas", "1", "--horizons", "4"]  # the grid it started with may be given again
+    assert sweep.main(["--resume", run_dir, *same, "--iterations", "4", "--no-plot", "--quiet"]) == 0
     recs = read(tmp_path / "sweep" / "sigma1-H4-s1" / "metrics.jsonl")
     assert [r["iteration"] for r in recs] == [2, 4]

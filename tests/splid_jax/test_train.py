@@ -5,6 +5,7 @@ signal is real."""
 import dataclasses
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -76,6 +77,18 @@ def final_params(run_dir):
         (["--sigma", "inf"], "sigma"),
         (["--sigma", "nan"], "sigma"),
         (["--num-envs", "100000000"], "num_envs"),  # refused from its shapes, before anything is allocated
+        (["--run-dir", ""], "run_dir"),
+        (["--bc-steps", "0"], "bc_steps"),  # no cloning step: the loss would be undefined
+        (["--gcsl-relabel", "future"], "gcsl_relabel"),  # flags the learner does not read
+        (["--pchid-every", "3"], "pchid_every"),
+        (["--algo", "gcsl", "--select"], "select"),
+        (["--algo", "gcsl", "--relabel", "settle"], "relabel"),
+        (["--algo", "gcsl", "--horizon", "3"], "horizon"),
+        (["--algo", "gcsl", "--select-radius", "0.5"], "select_radius"),
+        (["--algo", "pchid", "--gcsl-relabel", "final"], "gcsl_relabel"),
+        (["--iterations", str(10**20)], "iterations"),
+        (["--batch-size", "2000000000"], "batch_size=2000000000"),  # the sizes named are the ones given
+        (["--env-options", "success_radius=1,success_radius=2"], "env_options"),  # which one was meant?
     ],
 )
 def test_bad_values_stop_before_any_work(tmp_path, capsys, args, field):
@@ -90,6 +103,15 @@ def test_abbreviated_flags_are_not_taken_for_others(tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:
         main(["--learning-rat", "0.1", "--run-dir", str(tmp_path / "run")])
     assert exc.value.code == 2 and "--learning-rat" in capsys.readouterr().err
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("args", [["--nope"], ["--iterations", "x"]])
+def test_a_typo_is_one_line_pointing_at_help(tmp_path, capsys, args):
+    with pytest.raises(SystemExit) as exc:
+        main([*args, "--run-dir", str(tmp_path / "run")])
+    err = capsys.readouterr().err.strip()
+    assert exc.value.code == 2 and len(err.splitlines()) == 1 and err.endswith("--help)")
     assert not (tmp_path / "run").exists()
 
 
@@ -312,3 +334,72 @@ def test_sigterm_saves_like_ctrl_c_and_the_run_resumes(tmp_path):
     assert step >= 10 and f"saved iteration {step} " in out
     assert main(["--resume", run_dir, "--iterations", str(step + 5), "--quiet"]) == 0
     assert [r["iteration"] for r in stable(run_dir)] == list(range(5, step + 10, 5))
+
+
+def test_bad_resumes_and_bad_saved_configs_are_one_line(tmp_path, capsys):
+    run_dir = tmp_path / "run"
+    assert main([*TINY, "--iterations", "5", "--run-dir", str(run_dir), "--quiet"]) == 0
+    files = {p: (run_dir / p).read_bytes() for p in ("config.json", "metrics.jsonl")}
+    capsys.readouterr()
+    assert main(["--resume", str(run_dir), "--run-dir", str(tmp_path / "x"), "--iterations", "10"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "invalid run_dir=" in err and "unset with --resume" in err
+    assert not (tmp_path / "x").exists()
+    saved = json.loads(files["config.json"])
+    for field, value in [("sigma", "high"), ("hidden", ["a", 64, 64]), ("num_envs", 32.5)]:
+        (run_dir / "config.json").write_text(json.dumps({**saved, field: value}))
+        assert main(["--resume", str(run_dir), "--iterations", "10"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and f"invalid {field}=" in err, err
+    (run_dir / "config.json").write_bytes(files["config.json"])
+    assert (run_dir / "metrics.jsonl").read_bytes() == files["metrics.jsonl"]
+    assert checkpoint.latest_step(str(run_dir)) == 5
+    (run_dir / "metrics.jsonl").unlink()  # its records cannot be made again: the resume says so
+    assert main(["--resume", str(run_dir), "--iterations", "10", "--quiet"]) == 0
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "warning:" in err and "missing or empty" in err and "1-5 are lost" in err
+    assert [r["iteration"] for r in stable(run_dir)] == [10]
+    shutil.rmtree(run_dir / "checkpoints")  # as a run stopped before its first save leaves it
+    (run_dir / "metrics.jsonl").write_text("")
+    assert main(["--resume", str(run_dir), "--iterations", "10"]) == 0
+    assert "stopped before its first checkpoint; starting it again" in capsys.readouterr().out
+    assert [r["iteration"] for r in stable(run_dir)] == [5, 10] and checkpoint.latest_step(str(run_dir)) == 10
+
+
+def test_an_unreadable_run_is_not_called_missing(tmp_path, capsys, monkeypatch):
+    (tmp_path / "config.json").write_text("{}")
+    real_access = os.access  # permissions that bar even root, as a read-only share does for others
+    monkeypatch.setattr(os, "access", lambda p, m: not str(p).endswith("config.json") and real_access(p, m))
+    assert main(["--resume", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "whose config.json can be read (Permission denied)" in err
+
+
+def test_a_torn_record_at_the_checkpoint_is_warned_of(tmp_path, capsys):
+    from splid_jax.runtime.loop import warn_of_gap
+
+    warn_of_gap("m.jsonl", [{"iteration": 5}, {"iteration": 10}], 10)
+    assert capsys.readouterr().err == ""
+    warn_of_gap("m.jsonl", [{"iteration": 5}], 10)  # the record of 10 was torn
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "ends at iteration 5" in err and "6-10 are lost" in err
+
+
+def test_a_full_disk_is_one_line_exit_3_and_keeps_the_last_whole_checkpoint(tmp_path, capsys, monkeypatch):
+    import errno
+
+    real_save, saves = checkpoint.save, []
+
+    def fills_up(run_dir, step, *a, **kw):
+        saves.append(step)
+        if len(saves) > 1:
+            raise OSError(errno.ENOSPC, "No space left on device", run_dir)
+        return real_save(run_dir, step, *a, **kw)
+
+    monkeypatch.setattr(checkpoint, "save", fills_up)
+    run_dir = tmp_path / "run"
+    args = [*TINY, "--iterations", "15", "--checkpoint-every", "1", "--run-dir", str(run_dir), "--quiet"]
+    assert main(args) == 3
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "no space left" in err and "iteration 5 is kept" in err
+    assert checkpoint.latest_step(str(run_dir)) == 5

@@ -46,7 +46,7 @@ class ImitationConfig:
         check(0 < self.select_lanes <= 1, "select_lanes", self.select_lanes, "in (0, 1]")
         check(self.buffer_size >= 1, "buffer_size", self.buffer_size, "an integer >= 1")
         check(self.batch_size >= 1, "batch_size", self.batch_size, "an integer >= 1")
-        check(self.bc_steps >= 0, "bc_steps", self.bc_steps, "an integer >= 0")
+        check(self.bc_steps >= 1, "bc_steps", self.bc_steps, "an integer >= 1 (no step leaves the loss undefined)")
         check(self.learning_rate > 0, "learning_rate", self.learning_rate, "> 0")
         check(0 <= self.policy_ema < 1, "policy_ema", self.policy_ema, "in [0, 1)")
         check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "hidden", self.hidden, "one or more widths >= 1")

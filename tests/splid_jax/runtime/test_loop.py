@@ -242,3 +242,13 @@ def test_signals_stop_a_wait_at_once():
         assert not finished.is_set()  # the wait ended with the signal, not with the work
     assert info.value.exit_code == 130
     assert signal.getsignal(signal.SIGINT) is before
+
+
+def test_the_compile_notice_estimates_by_task_kind():
+    import envs
+    from splid_jax.runtime.memory import compile_hint
+
+    # the hint reads the task's class only: instances made without building their models
+    hints = {name: compile_hint(object.__new__(envs.task_class(name))) for name in ("point", "reacher", "reach")}
+    assert "15 s" in hints["point"] and "MJX" in hints["reacher"] and "Fetch" in hints["reach"]
+    assert len(set(hints.values())) == 3
