@@ -1,4 +1,5 @@
-"""Why a path cannot be read: a file behind a directory without permission is no missing file."""
+"""Paths a command is about to use: why one cannot be read (a file behind a directory without
+permission is no missing file), and which directories making one would create."""
 
 from __future__ import annotations
 
@@ -15,3 +16,13 @@ def unreadable(path: str) -> str | None:
         return e.strerror
     want = os.R_OK | (os.X_OK if os.path.isdir(path) else 0)
     return None if os.access(path, want) else "Permission denied"
+
+
+def missing_parents(path: str) -> list[str]:
+    """The directories ``os.makedirs(path)`` would create, deepest first: what to remove again when
+    the work they were made for does not happen."""
+    made, path = [], os.path.abspath(path)
+    while not os.path.exists(path):
+        made.append(path)
+        path = os.path.dirname(path)
+    return made

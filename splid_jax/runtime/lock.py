@@ -11,17 +11,9 @@ import os
 from collections.abc import Iterator
 
 from splid_jax.common.errors import InvalidConfig
+from splid_jax.common.paths import missing_parents
 
 LOCK = ".lock"
-
-
-def _missing_parents(path: str) -> list[str]:
-    """The directories ``os.makedirs(path)`` would create, deepest first."""
-    made, path = [], os.path.abspath(path)
-    while not os.path.exists(path):
-        made.append(path)
-        path = os.path.dirname(path)
-    return made
 
 
 def _holder(fd: int) -> str:
@@ -33,7 +25,7 @@ def _holder(fd: int) -> str:
 def acquire(run_dir: str, field: str = "run_dir") -> tuple[int, list[str]]:
     """The locked file's descriptor and the directories made for it; raises ``InvalidConfig`` when
     another live process holds the lock (nothing made then) or the directory cannot be written."""
-    made = _missing_parents(run_dir)
+    made = missing_parents(run_dir)
     path = os.path.join(run_dir, LOCK)
     try:
         os.makedirs(run_dir, exist_ok=True)

@@ -9,6 +9,7 @@ import os
 
 import envs
 from splid_jax.common.errors import InvalidConfig
+from splid_jax.common.paths import missing_parents
 from splid_jax.config import TrainConfig
 from splid_jax.runtime import checkpoint, progress
 
@@ -94,10 +95,7 @@ def check_run_dir(cfg: TrainConfig, resume: bool) -> int | None:
 def check_writable(run_dir: str) -> None:
     """Creates ``run_dir`` and a file in it, then removes what it made: a read-only filesystem or
     /proc fails here, naming the directory, before any work."""
-    made, path = [], os.path.abspath(run_dir)
-    while not os.path.exists(path):
-        made.append(path)
-        path = os.path.dirname(path)
+    made = missing_parents(run_dir)
     try:
         for d in reversed(made):
             os.mkdir(d)
