@@ -109,6 +109,9 @@ class _FetchTask(GoalEnv):
     # Training only (experimental): this share of resets starts with the object between the closed fingers
     # (PickAndPlace), HER 2017's protocol; evaluation_task() resets it to 0: success is measured from standard starts.
     grasped_starts: float = experimental(0.0)
+    # How far above the fingertips-on-the-table height the gripper target may go down (m); the reference's
+    # longer fingers meet its table 0.01 m higher than ours.
+    floor_clearance: float = experimental(0.0)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -138,6 +141,7 @@ class _FetchTask(GoalEnv):
         grasp_range = "in [0, 1]" if not self.block_gripper else "0 (the fingers are locked on this task)"
         ok = 0 <= self.grasped_starts <= 1 and (self.grasped_starts == 0 or not self.block_gripper)
         check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
+        check(0 <= self.floor_clearance <= 0.1, f"{n}.floor_clearance", self.floor_clearance, "in [0, 0.1] m")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -288,7 +292,8 @@ class _FetchTask(GoalEnv):
         lay = self.layout
         g = lay.grip_q
         reach = lay.reach_center if self.workspace == "arm" else None
-        target = models.gripper_target(phys.qpos[g : g + 3], action[:3], lay.grip_home, lay.workspace_lo,
+        lo = (*lay.workspace_lo[:2], lay.workspace_lo[2] + self.floor_clearance)
+        target = models.gripper_target(phys.qpos[g : g + 3], action[:3], lay.grip_home, lo,
                                        lay.workspace_hi, reach, xp=jnp)  # fmt: skip
         ctrl = phys.ctrl.at[0:3].set(target)
         if lay.finger_q is not None:

@@ -129,6 +129,7 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("push", "cholesky", "lapack"),
         ("slide", "workspace", "sphere"),
         ("push", "drive", "mocap"),
+        ("reach", "floor_clearance", -0.01),
     ],
 )
 def test_bad_overrides_fail_naming_the_field(name, field, value):
@@ -408,3 +409,12 @@ def test_grasped_starts_mix_by_share_and_need_free_fingers():
         envs.make("push", grasped_starts=0.5)
     with pytest.raises(InvalidConfig, match="grasped_starts"):
         envs.make("pick_and_place", grasped_starts=1.5)
+
+
+def test_floor_clearance_raises_the_lowest_gripper_target():
+    low = np.asarray(models.workspace_box("reach")[0])
+    for clearance in (0.0, 0.01):
+        env = envs.make("reach", floor_clearance=clearance)
+        home = np.asarray(env.layout.grip_home)
+        target = _target_after(env, [home[0], home[1], low[2] + 0.002], [0.0, 0.0, -1.0, 0.0])
+        assert target[2] == pytest.approx(low[2] + clearance, abs=1e-6)
