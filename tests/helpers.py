@@ -48,3 +48,16 @@ def random_policy_success(env: GoalEnv, episodes: int = 256) -> float:
         return jnp.any(jax.lax.scan(one, s, jax.random.split(k1, env.episode_length))[1])
 
     return float(jnp.mean(jax.jit(jax.vmap(episode))(jax.random.split(jax.random.PRNGKey(7), episodes))))
+
+
+def with_counted_jit(learner):
+    """``learner`` with ``jitted``, its jitted chunk, and ``traces``, how often Python traced it: one
+    per compilation."""
+    learner.traces = 0
+
+    def counted(state, hyper):
+        learner.traces += 1
+        return learner.chunk(state, hyper)
+
+    learner.jitted = jax.jit(counted)
+    return learner

@@ -13,6 +13,7 @@ from splid_jax.common.evaluation import evaluate
 from splid_jax.config import TrainConfig
 from splid_jax.learners.es.config import EsConfig
 from splid_jax.learners.es.learner import ES
+from tests.helpers import with_counted_jit
 
 CFG = dict(env="point", hidden=(32, 32), iterations=80, eval_every=10, eval_episodes=256)
 ES_CFG = dict(population=128, sigma=0.05)
@@ -21,15 +22,7 @@ CHUNKS = 8
 
 @pytest.fixture(scope="module")
 def es():
-    es = ES(envs.make("point"), TrainConfig(**CFG), EsConfig(**ES_CFG))
-    es.traces = 0
-
-    def counted(state, hyper):  # counts Python traces: one per compilation
-        es.traces += 1
-        return es.chunk(state, hyper)
-
-    es.jitted = jax.jit(counted)
-    return es
+    return with_counted_jit(ES(envs.make("point"), TrainConfig(**CFG), EsConfig(**ES_CFG)))
 
 
 def run_chunks(es, seed, chunks):

@@ -17,7 +17,7 @@ from splid_jax.learners.her import episode_buffer
 from splid_jax.learners.her import learner as her_mod
 from splid_jax.learners.her.config import HerConfig
 from splid_jax.learners.her.learner import HER
-from tests.helpers import random_policy_success
+from tests.helpers import random_policy_success, with_counted_jit
 
 CFG = dict(env="point", num_envs=16, iterations=150, eval_every=25, eval_episodes=256)
 HER_CFG = dict(hidden=(64, 64, 64), buffer_transitions=100_000, batch_size=256)
@@ -26,15 +26,7 @@ CHUNKS = 6  # 150 cycles, 2,400 episodes
 
 @pytest.fixture(scope="module")
 def her():
-    her = HER(envs.make("point"), TrainConfig(**CFG), HerConfig(**HER_CFG))
-    her.traces = 0
-
-    def counted(state, hyper):  # counts Python traces: one per compilation
-        her.traces += 1
-        return her.chunk(state, hyper)
-
-    her.jitted = jax.jit(counted)
-    return her
+    return with_counted_jit(HER(envs.make("point"), TrainConfig(**CFG), HerConfig(**HER_CFG)))
 
 
 def run_chunks(her, seed, chunks):

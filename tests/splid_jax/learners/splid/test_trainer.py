@@ -8,7 +8,7 @@ import pytest
 import envs
 from splid_jax.config import TrainConfig
 from splid_jax.learners.splid.trainer import Trainer
-from tests.helpers import random_policy_success
+from tests.helpers import random_policy_success, with_counted_jit
 
 pytestmark = pytest.mark.slow  # trains
 
@@ -17,15 +17,7 @@ CFG = dict(env="point", num_envs=16, iterations=40, eval_every=10, bc_steps=50, 
 
 @pytest.fixture(scope="module")
 def trainer():
-    trainer = Trainer(envs.make("point"), TrainConfig(**CFG))
-    trainer.traces = 0
-
-    def counted(state, hyper):  # counts Python traces: one per compilation
-        trainer.traces += 1
-        return trainer.chunk(state, hyper)
-
-    trainer.jitted = jax.jit(counted)
-    return trainer
+    return with_counted_jit(Trainer(envs.make("point"), TrainConfig(**CFG)))
 
 
 def run_chunks(trainer, seed, chunks):
