@@ -52,7 +52,11 @@ def _is_a(value: Any, kind: str) -> bool:
 @dataclasses.dataclass(frozen=True)
 class TrainConfig:
     env: str = field("point", "task: " + ", ".join(envs.names()))
-    seed: int = field(0, "PRNG seed; the same seed on the same device gives the same run")
+    seed: int = field(
+        0,
+        "PRNG seed; the same seed gives the same run from the same compiled program (the compile cache keeps "
+        "it); a fresh compilation on a GPU may pick other kernels and round differently",
+    )
     iterations: int = field(None, "SPLID iterations (explore, select, behaviour cloning); a multiple of eval_every")
     num_envs: int = field(
         None,
