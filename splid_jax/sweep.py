@@ -44,6 +44,7 @@ from splid_jax.runtime import (  # noqa: E402
     run_files,  # noqa: E402
 )
 from splid_jax.runtime.loop import RunStopped, make_env  # noqa: E402
+from splid_jax.tensorboard import recording  # noqa: E402
 
 
 @dataclasses.dataclass(frozen=True)
@@ -127,6 +128,12 @@ def build_parser() -> Parser:
     parser.add_argument("--resume", metavar="RUN_DIR", help="continue the sweep saved in RUN_DIR (its sweep.json)")
     parser.add_argument("--no-plot", action="store_true", help="skip the grid figure")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
+    parser.add_argument(
+        "--tensorboard",
+        metavar="DIR",
+        help="also write every member's metrics as TensorBoard scalars under DIR/MEMBER, against episodes "
+        '(needs pip install -e ".[tensorboard]")',
+    )
     add_compile_cache_flag(parser)
     add_launch_flags(parser)
     return parser
@@ -187,7 +194,8 @@ def main(argv: list[str] | None = None) -> int:
             cfg, lanes = member_configs(TrainConfig(**{**given, "horizon": max(horizons), "sigma": max(sigmas)}), grid)
         env = make_env(cfg.env, **cfg.env_overrides())
         cfg.check_env(env)
-        loop.run(cfg, env, members=lanes, resume=bool(ns.resume), quiet=ns.quiet)
+        with recording(ns.tensorboard, per_member=True) as on_record:
+            loop.run(cfg, env, members=lanes, resume=bool(ns.resume), quiet=ns.quiet, on_record=on_record)
     except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 2

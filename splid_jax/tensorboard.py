@@ -10,9 +10,14 @@ Needs the optional extra: ``pip install -e ".[tensorboard]"`` (tensorboardX).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
+import os
 import sys
+from collections.abc import Callable, Iterator
+
+from splid_jax.common.errors import InvalidConfig
 
 STEP_KEY = "episodes"
 EXTRA = 'pip install -e ".[tensorboard]"'
@@ -59,6 +64,33 @@ class MetricsWriter:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+@contextlib.contextmanager
+def recording(log_dir: str | None, per_member: bool = False) -> Iterator[Callable[[str, dict], None] | None]:
+    """The host loop's ``on_record`` callback writing every record under ``log_dir`` (a sweep's members
+    each in the subdirectory of its run directory's name), or None without a directory. A missing
+    extra is a mistake in the command line, found before any work."""
+    if not log_dir:
+        yield None
+        return
+    try:
+        import tensorboardX  # noqa: F401
+    except ImportError:
+        raise InvalidConfig("tensorboard", log_dir, f"given with tensorboardX installed ({EXTRA})") from None
+    writers: dict[str, MetricsWriter] = {}
+
+    def on_record(run_dir: str, record: dict) -> None:
+        name = os.path.basename(os.path.normpath(run_dir)) if per_member else ""
+        if name not in writers:
+            writers[name] = MetricsWriter(os.path.join(log_dir, name))
+        writers[name].write(record)
+
+    try:
+        yield on_record
+    finally:
+        for writer in writers.values():
+            writer.close()
 
 
 def convert(metrics_path: str, log_dir: str) -> int:

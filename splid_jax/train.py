@@ -48,16 +48,10 @@ def run(
 ) -> dict:
     """Train one run to ``cfg.iterations``; returns its last metrics record. ``tensorboard``: a
     directory that also receives every record as TensorBoard scalars."""
-    if not tensorboard:
-        return loop.run(cfg, env, resume=resume, quiet=quiet)[0]
-    from splid_jax.tensorboard import MetricsWriter, TensorBoardUnavailable
+    from splid_jax.tensorboard import recording
 
-    try:
-        writer = MetricsWriter(tensorboard)
-    except TensorBoardUnavailable as err:
-        raise InvalidConfig("tensorboard", tensorboard, f"a directory, with {err}") from None
-    with writer:
-        return loop.run(cfg, env, resume=resume, quiet=quiet, on_record=lambda _, rec: writer.write(rec))[0]
+    with recording(tensorboard) as on_record:
+        return loop.run(cfg, env, resume=resume, quiet=quiet, on_record=on_record)[0]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -80,3 +80,37 @@ def test_train_writes_every_record_to_tensorboard(tmp_path):
     seen = read_scalars(str(log_dir))
     assert [step for step, _ in seen["eval_success_final"]] == [r["episodes"] for r in records]
     assert [v for _, v in seen["eval_success"]] == pytest.approx([r["eval_success"] for r in records])
+
+
+def test_sweep_writes_each_member_under_its_own_name(tmp_path):
+    from splid_jax import sweep
+
+    run_dir, log_dir = tmp_path / "sweep", tmp_path / "tb"
+    argv = ["--env", "point", "--seeds", "2", "--iterations", "5", "--num-envs", "8", "--eval-episodes", "8"]
+    argv += ["--bc-steps", "5", "--run-dir", str(run_dir), "--quiet", "--no-plot", "--compile-cache", ""]
+    assert sweep.main([*argv, "--tensorboard", str(log_dir)]) == 0
+    for member in sorted(p.name for p in run_dir.iterdir() if (p / "metrics.jsonl").is_file()):
+        records = [json.loads(line) for line in (run_dir / member / "metrics.jsonl").read_text().splitlines()]
+        seen = read_scalars(str(log_dir / member))
+        assert [v for _, v in seen["eval_success_final"]] == pytest.approx([r["eval_success_final"] for r in records])
+
+
+def test_a_missing_extra_is_one_line_before_any_work(tmp_path, monkeypatch, capsys):
+    import builtins
+
+    from splid_jax import train
+
+    real_import = builtins.__import__
+
+    def no_tensorboardx(name, *args, **kwargs):
+        if name == "tensorboardX":
+            raise ImportError(name)
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_tensorboardx)
+    run_dir = tmp_path / "run"
+    argv = ["--env", "point", "--iterations", "5", "--run-dir", str(run_dir), "--tensorboard", str(tmp_path / "tb")]
+    assert train.main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "tensorboardX" in err and "tensorboard" in err
+    assert not (run_dir / "metrics.jsonl").exists()
