@@ -67,7 +67,8 @@ def load_policy(cfg: TrainConfig, step: int | None = None):
 
 
 def rollout(env, trainer, pstate, key, episodes: int):
-    """Episodes of the deterministic policy: the states [T + 1, E]."""
+    """Episodes of the deterministic policy from the task's standard starts: the states [T + 1, E]."""
+    env = env.evaluation_task()
 
     def one_step(s, _):
         nxt = step_batch(env, s, trainer.policy.act(pstate, s.obs, s.desired_goal))
