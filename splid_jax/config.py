@@ -80,7 +80,8 @@ class TrainConfig:
         "splid/pchid candidates: paper (Algorithm 2 exactly), hold (also steps whose goal is already "
         "achieved and held for H steps, kept when the policy is not at the goal after H steps) or settle "
         "(experimental: hold, and a moved goal only where the object then stays there H steps; every "
-        "verdict at the final step)",
+        "verdict at the final step) or stop (hold, with the held pairs labelled by the zero action: stand still "
+        "at a reached goal)",
     )
     select_radius: float = field(
         1.0,

@@ -38,6 +38,12 @@ TABLE_TOP = 0.4
 OBJECT_HALF = 0.025
 PUCK_HALF_HEIGHT = 0.02
 FINGER_BELOW_SITE = 0.008  # the fingertips reach this far below the grip site
+# With a finger-table contact (``finger_table`` > 0) the fingertips reach as far down as the reference's, which
+# touch its table with the grip site at 0.416 to 0.420 (2 to 3 mm into it at the Push start, grip at 0.416).
+REFERENCE_FINGER_BELOW_SITE = 0.019
+# How far below the fingertips-on-the-table height the target may go with that contact: the press that, at
+# the reference's finger friction 1, drags the gripper as the reference's mocap weld drags its fingers.
+FINGER_PRESS = 0.025
 GRIPPER_MASS = 4.0  # palm + fingers, the mass the xyz drive moves
 DRIVE_OMEGA = 50.0  # rad/s: the reference weld's time constant 0.02 s
 FINGER_KP = 30000.0
@@ -95,12 +101,15 @@ def within_reach(grip, target, center, radius=ARM_REACH_RADIUS, stretch_gain=ARM
     return center + off * xp.minimum(1.0, radius / xp.maximum(dist, 1e-9))
 
 
-def workspace_box(kind: str):
+def workspace_box(kind: str, finger_table: float = 0.0):
     """World xyz (lo, hi) of the box the gripper target is clipped to: the table and 15 cm around it in
-    xy, from the fingertips on the table top to 0.6 m above it."""
+    xy, from the fingertips on the table top to 0.6 m above it. With a finger-table contact the floor is
+    ``FINGER_PRESS`` below the fingertips on the table: there the table, not the box, stops the gripper,
+    and a downward command presses it on the table and drags it as in the reference."""
     (tx, ty, _), (hx, hy, _), _ = _SCENES[kind]
     margin = 0.15
-    return ((tx - hx - margin, ty - hy - margin, TABLE_TOP + FINGER_BELOW_SITE),
+    floor = TABLE_TOP + (REFERENCE_FINGER_BELOW_SITE - FINGER_PRESS if finger_table > 0 else FINGER_BELOW_SITE)
+    return ((tx - hx - margin, ty - hy - margin, floor),
             (tx + hx + margin, ty + hy + margin, TABLE_TOP + 0.6))
 
 
@@ -167,6 +176,7 @@ def mjcf(
     drive_damping_ratio: float = 1.0,
     drive_damping: str = "joint",
     drive: str = "pd",
+    finger_table: float = 0.0,
 ) -> str:
     """The MJCF text of task ``kind`` (one of ``KINDS``); ``table`` is the table's collision shape
     (``tables_for(kind)``), ``finger`` the closed finger block's (``fingers_for(kind)``).
@@ -181,7 +191,11 @@ def mjcf(
     connect constraint with the reference weld's solref and solimp (``WELD_SOLREF``, ``WELD_SOLIMP``)
     instead of the PD drive: the reference's drive law on our gripper. Whoever steps the model puts the
     mocap body at the grip site's target (the tasks' field ``drive``, ``experiments/parity/slide_c.py``);
-    ``ctrl[0:3]`` then moves nothing."""
+    ``ctrl[0:3]`` then moves nothing.
+
+    ``finger_table`` > 0 (Reach, Push, PickAndPlace): the fingers reach ``REFERENCE_FINGER_BELOW_SITE``
+    below the grip site and touch the table with this friction (condim 3), so a gripper driven down at
+    the table presses on it and drags, as the reference's does under its mocap weld; 0: no such contact."""
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
     if table not in tables_for(kind):
@@ -196,6 +210,8 @@ def mjcf(
         raise ValueError(f"drive_damping must be 'joint' or 'actuator', got {drive_damping!r}")
     if drive not in DRIVES:
         raise ValueError(f"drive must be one of {DRIVES}, got {drive!r}")
+    if finger_table < 0 or (finger_table > 0 and kind == "slide"):
+        raise ValueError(f"finger_table must be >= 0 (0 on slide), got {finger_table}")
     (tx, ty, tz), (hx, hy, hz), (gx, gy, gz) = _SCENES[kind]
     has_object = kind != "reach"
     free_fingers = kind == "pick_and_place"
@@ -215,7 +231,8 @@ def mjcf(
     obj_half = (OBJECT_HALF, OBJECT_HALF, PUCK_HALF_HEIGHT if slide else OBJECT_HALF)
     rest_z = TABLE_TOP + obj_half[2]
     ox, oy = gx + 0.1, gy + 0.1  # any spot on the table; reset moves it
-    finger_z = 0.03 - FINGER_BELOW_SITE  # finger box half-height 0.03, bottom at -FINGER_BELOW_SITE
+    below = REFERENCE_FINGER_BELOW_SITE if finger_table > 0 else FINGER_BELOW_SITE
+    finger_z = 0.03 - below  # finger box half-height 0.03, bottom ``below`` the grip site
     palm_mass = mass - (2 * FINGER_MASS if free_fingers else 0.0)
     friction = "0.1 0.1 0.005 0.0001 0.0001" if slide else "1 1 0.005 0.0001 0.0001"
     nograv = 'contype="0" conaffinity="0"'
@@ -295,6 +312,14 @@ def mjcf(
             obj_pairs += """
     <pair geom1="object" geom2="floor" condim="3"/>"""
 
+    if finger_table > 0:
+        names = ("finger_l", "finger_r") if free_fingers else ("fingers",)
+        finger_pairs += "".join(
+            f"""
+    <pair geom1="{n}" geom2="table" condim="3" friction="{finger_table:.6g} {finger_table:.6g} 0.005 0.0001 0.0001"/>"""
+            for n in names
+        )
+
     return f"""<mujoco model="fetch_{kind}">
   <compiler angle="radian" autolimits="true"/>
   <option timestep="{timestep:.6g}" integrator="Euler" solver="Newton" iterations="{iterations}"
@@ -347,7 +372,7 @@ def build(kind: str, **options):
     object_q = int(jnt("object").qposadr[0]) if kind != "reach" else None
     object_v = int(jnt("object").dofadr[0]) if kind != "reach" else None
     home = _SCENES[kind][2]
-    lo, hi = workspace_box(kind)
+    lo, hi = workspace_box(kind, options.get("finger_table", 0.0))
     rest_z = _rest_height(m, object_q) if object_q is not None else None
     layout = Layout(
         grip_q=grip_q,

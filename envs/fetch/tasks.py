@@ -112,6 +112,9 @@ class _FetchTask(GoalEnv):
     # How far above the fingertips-on-the-table height the gripper target may go down (m); the reference's
     # longer fingers meet its table 0.01 m higher than ours.
     floor_clearance: float = experimental(0.0)
+    # Friction of a contact between the fingers and the table (models.mjcf's finger_table); 0: none. With it
+    # the fingers are as long as the reference's and a gripper driven down at the table presses and drags.
+    finger_table: float = experimental(0.0)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -142,6 +145,9 @@ class _FetchTask(GoalEnv):
         ok = 0 <= self.grasped_starts <= 1 and (self.grasped_starts == 0 or not self.block_gripper)
         check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
         check(0 <= self.floor_clearance <= 0.1, f"{n}.floor_clearance", self.floor_clearance, "in [0, 0.1] m")
+        table_range = "0 (the puck is struck by fingertips)" if n == "slide" else "in [0, 2]"
+        ok = 0 <= self.finger_table <= 2 and (self.finger_table == 0 or n != "slide")
+        check(ok, f"{n}.finger_table", self.finger_table, table_range)
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -171,6 +177,7 @@ class _FetchTask(GoalEnv):
             table=str(self.table),
             finger=str(self.finger),
             drive=str(self.drive),
+            finger_table=float(self.finger_table),
         )
 
     @property

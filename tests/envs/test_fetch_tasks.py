@@ -130,6 +130,8 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("slide", "workspace", "sphere"),
         ("push", "drive", "mocap"),
         ("reach", "floor_clearance", -0.01),
+        ("slide", "finger_table", 1.0),  # the puck is struck by fingertips, not the finger block
+        ("push", "finger_table", -1.0),
     ],
 )
 def test_bad_overrides_fail_naming_the_field(name, field, value):
@@ -418,3 +420,30 @@ def test_floor_clearance_raises_the_lowest_gripper_target():
         home = np.asarray(env.layout.grip_home)
         target = _target_after(env, [home[0], home[1], low[2] + 0.002], [0.0, 0.0, -1.0, 0.0])
         assert target[2] == pytest.approx(low[2] + clearance, abs=1e-6)
+
+
+def _pressed_paths(env, action, steps=6):
+    """Grip positions [steps + 1, 3] under ``action`` held from the start (the object moved out of the way)."""
+    state = env.reset(jax.random.PRNGKey(0))
+    lay = env.layout
+    qpos = state.physics.qpos.at[lay.object_q : lay.object_q + 2].set(jnp.array([1.6, 0.4]))
+    state = state.replace(physics=state.physics.replace(qpos=qpos))
+    step = jax.jit(env.step)
+    path = [np.asarray(state.obs[:3])]
+    for _ in range(steps):
+        state = step(state, jnp.asarray(action, jnp.float32))
+        path.append(np.asarray(state.obs[:3]))
+    return np.array(path)
+
+
+def test_finger_table_contact_drags_a_gripper_pressed_on_the_table():
+    with_contact = envs.make("push", finger_table=1.0)
+    free = _pressed_paths(with_contact, [0.0, 1.0, 0.0, 0.0])
+    pressed = _pressed_paths(with_contact, [0.0, 1.0, -1.0, 0.0])
+    speed = lambda p: np.linalg.norm(np.diff(p[2:, :2], axis=0), axis=-1).mean()  # noqa: E731
+    assert speed(pressed) < 0.7 * speed(free)  # the reference: 16 against 33 mm per step
+    table_height = models.TABLE_TOP + models.REFERENCE_FINGER_BELOW_SITE
+    assert pressed[:, 2].min() > table_height - 0.005  # the table, not the workspace floor, holds it
+    without = _pressed_paths(envs.make("push"), [0.0, 1.0, -1.0, 0.0])
+    assert speed(without) == pytest.approx(speed(free), rel=0.05)  # no contact: pressing costs nothing
+    assert without[-1, 2] < table_height - 0.005

@@ -9,7 +9,8 @@ import dataclasses
 
 from splid_jax.common.errors import check
 
-RELABELS = ("paper", "hold", "settle")
+RELABELS = ("paper", "hold", "settle", "stop")
+HOLDING = ("hold", "settle", "stop")  # the relabellings that add held-goal candidates
 GCSL_RELABELS = ("final", "future")
 
 

@@ -15,7 +15,12 @@ program (MJX compile time).
 s_t and still achieved H steps later (the explored actions kept the object there). Their verdict is
 taken at the final step: the pair is kept only if the policy, restored at s_t, is NOT at g' after H
 steps. Without them the buffer never holds a state whose goal is achieved, so the policy is never
-shown what to do there and pushes through the goal."""
+shown what to do there and pushes through the goal.
+
+``stop=True`` labels those held pairs with the zero action instead of the explored one: on the Fetch
+tasks it holds the gripper where it is (the target is the current grip position, the fingers keep
+their opening), so at a goal already reached the policy is taught to stand still rather than to copy
+exploration noise that happened not to disturb the object."""
 
 from __future__ import annotations
 
@@ -136,6 +141,7 @@ def select(
     hold: bool = False,
     settle: bool = False,
     radius: float = 1.0,
+    stop: bool = False,
 ) -> Candidates:
     """``max_horizon`` fixes the shapes; ``horizon`` (traced, <= max_horizon) masks the candidates
     of larger h, so runs with different H share one compiled program. ``use_select=False`` is the
@@ -145,7 +151,8 @@ def select(
     ``settle`` (with ``hold``) keeps only moved candidates whose object then stays at g' for the next
     H steps (or to the episode's end), and judges every candidate at its final step: the explored
     actions are imitated where they leave the object at g' and the policy does not. ``radius`` scales
-    the task's success threshold for every test here (``within``)."""
+    the task's success threshold for every test here (``within``). ``stop`` (with ``hold``) labels the
+    held candidates with the zero action (module docstring)."""
     T, H = env.episode_length, max_horizon
     n = traj.actions.shape[1]
     hs = jnp.arange(1, H + 1)
@@ -183,6 +190,9 @@ def select(
     else:
         accept, steps = valid, jnp.int32(0)
     tile = lambda x: jnp.broadcast_to(x[None], (H,) + x.shape).reshape((H * T * n,) + x.shape[2:])  # noqa: E731
-    out = Candidates(tile(traj.states.obs), goal, tile(traj.actions), valid, accept, held, steps)
+    action = tile(traj.actions)
+    if stop:
+        action = jnp.where(held[:, None], jnp.zeros_like(action), action)
+    out = Candidates(tile(traj.states.obs), goal, action, valid, accept, held, steps)
     chex.assert_shape([out.valid, out.accept, out.held], (num_candidates(T, H, n),))
     return out

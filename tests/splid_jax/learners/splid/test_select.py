@@ -31,19 +31,19 @@ def policy(env):
 @pytest.fixture(scope="module")
 def run_select(env, policy):
     """``run_select(pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False,
-    radius=1.0)``: SELECT, jitted once per setting."""
+    radius=1.0, stop=False)``: SELECT, jitted once per setting."""
 
     @functools.cache
     def jitted(*static):
-        use_select, lanes, hold, settle, radius = static
+        use_select, lanes, hold, settle, radius, stop = static
         return jax.jit(
             lambda ps, tr, hz: select(
-                env, policy, ps, tr, H, hz, use_select, lanes, hold=hold, settle=settle, radius=radius
+                env, policy, ps, tr, H, hz, use_select, lanes, hold=hold, settle=settle, radius=radius, stop=stop
             )
         )
 
-    def run(pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False, radius=1.0):
-        return jitted(use_select, lanes, hold, settle, radius)(pstate, traj, jnp.int32(horizon))
+    def run(pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False, radius=1.0, stop=False):
+        return jitted(use_select, lanes, hold, settle, radius, stop)(pstate, traj, jnp.int32(horizon))
 
     return run
 
@@ -189,6 +189,20 @@ def test_held_goals_are_kept_where_the_policy_leaves_them_and_judged_at_the_fina
     assert bool(policy_reaches(env, policy, drift, there, goal, H)) and not bool(
         policy_reaches(env, policy, drift, there, goal, H, at_final=True)
     )
+
+
+def test_stop_labels_the_held_pairs_with_the_zero_action_and_keeps_the_rest(env, policy, run_select):
+    """``stop``: the same verdicts as ``hold``; the held pairs' action becomes 0, the moved ones keep theirs."""
+    traj = scripted_trajectory(env, [[0.0, 0.4]], start=(-2.0, -4.8))  # env 0 moves, the others stand still
+    drift = constant_policy(policy, [1.0, 0.0])
+    held, stopped = run_select(drift, traj, hold=True), run_select(drift, traj, hold=True, stop=True)
+    np.testing.assert_array_equal(stopped.accept, held.accept)
+    np.testing.assert_array_equal(stopped.held, held.held)
+    h, action = np.asarray(held.held), np.asarray(stopped.action)
+    assert h.any() and (np.asarray(held.valid) & ~h).any()
+    np.testing.assert_array_equal(action[h], 0.0)
+    np.testing.assert_array_equal(action[~h], np.asarray(held.action)[~h])
+    assert np.abs(np.asarray(held.action)[np.asarray(held.valid) & ~h]).max() > 0
 
 
 def test_settle_keeps_moved_goals_where_the_object_then_stays_and_radius_scales_the_threshold(
