@@ -260,7 +260,7 @@ TASK_DEFAULTS: dict[str, dict[str, Any]] = {
         **_FETCH,
         "iterations": 80,
         "num_envs": 125,
-        "relabel": "hold",
+        "relabel": "stop",
         "normalise": False,
         "relative_goal": True,
         "sigma_end": 0.5,

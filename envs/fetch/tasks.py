@@ -114,6 +114,7 @@ class _FetchTask(GoalEnv):
     floor_clearance: float = experimental(0.0)
     # Friction of a contact between the fingers and the table (models.mjcf's finger_table); 0: none. With it
     # the fingers are as long as the reference's and a gripper driven down at the table presses and drags.
+    # Push: 1 (the reference's), the others 0.
     finger_table: float = experimental(0.0)
 
     kind = ""  # models.KINDS entry
@@ -353,8 +354,11 @@ class Reach(_FetchTask):
 
 @dataclasses.dataclass(frozen=True)
 class Push(_FetchTask):
-    """Push a 5 cm cube to a goal on the table; fingers locked closed."""
+    """Push a 5 cm cube to a goal on the table; fingers locked closed. The fingers touch the table
+    (``finger_table``, the reference's friction 1): a policy trained where pressing down on the table
+    costs nothing presses there, and in the reference that drags its gripper and loses the cube."""
 
+    finger_table: float = 1.0
     kind = "push"
 
 
