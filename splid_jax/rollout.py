@@ -23,7 +23,7 @@ from splid_jax.learners.registry import make_algorithm
 from splid_jax.runtime import checkpoint
 from splid_jax.runtime.loop import make_env
 from splid_jax.runtime.memory import device_memory, gigabytes, nbytes
-from splid_jax.runtime.run_files import env_settings
+from splid_jax.runtime.run_files import task_change_note
 
 DESCRIPTION = (
     "Roll a run's deterministic policy out, report its success and draw the episodes: their paths, "
@@ -58,11 +58,9 @@ def load_policy(cfg: TrainConfig, step: int | None = None):
     trainer = make_algorithm(cfg, env)
     like = jax.eval_shape(trainer.init, jax.random.PRNGKey(0))
     step, state, meta = checkpoint.restore(cfg.run_dir, like, step=step)
-    saved, now = meta["env"], env_settings(env)
-    changed = [k for k in now if saved.get(k) != now[k]]
-    if changed:  # the policy is still worth a look under the changed task, so say it rather than stop
-        what = ", ".join(f"{k}={saved.get(k)!r} then, {now[k]!r} now" for k in changed)
-        print(f"note: {cfg.run_dir} was trained on another version of the task ({what})", file=sys.stderr)
+    note = task_change_note(cfg.run_dir, meta["env"], env)
+    if note:
+        print(note, file=sys.stderr)
     return env, trainer, state, step
 
 

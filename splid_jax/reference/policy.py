@@ -8,6 +8,7 @@ import dataclasses
 import io
 import json
 import os
+import sys
 
 import numpy as np
 
@@ -37,13 +38,17 @@ def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
     from splid_jax.learners.registry import make_algorithm
     from splid_jax.runtime import checkpoint
     from splid_jax.runtime.loop import make_env
+    from splid_jax.runtime.run_files import task_change_note
 
     directory, index, members = sweep
     env = make_env(cfg.env, **cfg.env_overrides())  # the member's task, with any changed fields
     with open(os.path.join(directory, "sweep.json")) as fh:
         trainer = make_algorithm(TrainConfig.from_json(json.load(fh)["config"], run_dir=directory), env)
     like = jax.eval_shape(jax.vmap(trainer.init), jax.random.split(jax.random.PRNGKey(0), members))
-    step, state, _ = checkpoint.restore(directory, like, step=step)
+    step, state, meta = checkpoint.restore(directory, like, step=step)
+    note = task_change_note(cfg.run_dir, meta.get("env", {}), env)
+    if note:
+        print(note, file=sys.stderr)
     return env, trainer, jax.tree.map(lambda x: x[index], state), step
 
 

@@ -24,6 +24,17 @@ def env_settings(env: envs.GoalEnv) -> dict:
     return json.loads(json.dumps(env.settings()))
 
 
+def task_change_note(run_dir: str, saved: dict, env: envs.GoalEnv) -> str | None:
+    """A line naming the task's options that differ from those a checkpoint recorded (``saved``): a
+    policy is still worth a look under a changed task, so loaders say it rather than stop."""
+    now = env_settings(env)
+    changed = [k for k in now if saved.get(k) != now[k]]
+    if not changed:
+        return None
+    what = ", ".join(f"{k}={saved.get(k)!r} then, {now[k]!r} now" for k in changed)
+    return f"note: {run_dir} was trained on another version of the task ({what})"
+
+
 def identity(cfg: TrainConfig) -> dict:
     """The settings a checkpoint must share with the run resuming it, as JSON stores them."""
     return json.loads(json.dumps({k: v for k, v in cfg.to_json().items() if k not in MAY_CHANGE_ON_RESUME}))
