@@ -6,7 +6,8 @@ for Reach), sparse reward ``-(d > threshold)``, 50-step episodes, action ``a`` i
 the gripper target by ``0.05 * a[:3]`` per 0.04 s control step.
 
 Gripper target: as in the reference, the *current* grip position plus ``0.05 * a[:3]``, clipped to
-a workspace box whose floor keeps the fingertips at or above the table, then within the reference
+a workspace box whose floor keeps the fingertips at or above the table (with ``finger_table`` the
+floor lies 2.5 cm lower and the fingers' contact with the table holds them), then within the reference
 arm's reach (``models.within_reach``; ``workspace="box"`` drops it). The target is the actuator
 control, which ``Physics`` holds (with ``drive="weld"``, ``simulate`` puts a mocap body there).
 
