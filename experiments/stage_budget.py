@@ -27,7 +27,7 @@ from splid_jax.common.evaluation import evaluate
 from splid_jax.config import TrainConfig
 from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.bc import bc_epoch
-from splid_jax.learners.imitation.config import HOLDING
+from splid_jax.learners.imitation.config import select_modes
 from splid_jax.learners.imitation.explore import draws, rollout
 from splid_jax.learners.registry import make_algorithm
 from splid_jax.learners.splid.select import select
@@ -68,8 +68,7 @@ def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: i
     def select_fn(pstate, traj):
         return select(
             env, algo.policy, pstate, traj, algo.max_horizon, horizon, cfg.select, cfg.select_lanes,
-            hold=cfg.relabel in HOLDING, settle=cfg.relabel == "settle", radius=cfg.select_radius,
-            stop=cfg.relabel == "stop",
+            radius=cfg.select_radius, **select_modes(cfg.relabel),
         )  # fmt: skip
 
     rows["select"], cands = timed(jax.jit(select_fn), pstate, traj, repeats=repeats)

@@ -23,7 +23,7 @@ from splid_jax.learners.registry import make_algorithm
 from splid_jax.runtime import checkpoint
 from splid_jax.runtime.loop import make_env
 from splid_jax.runtime.memory import device_memory, gigabytes, nbytes
-from splid_jax.runtime.run_files import task_change_note
+from splid_jax.runtime.run_files import note_task_changes
 
 DESCRIPTION = (
     "Roll a run's deterministic policy out, report its success and draw the episodes: their paths, "
@@ -58,9 +58,7 @@ def load_policy(cfg: TrainConfig, step: int | None = None):
     trainer = make_algorithm(cfg, env)
     like = jax.eval_shape(trainer.init, jax.random.PRNGKey(0))
     step, state, meta = checkpoint.restore(cfg.run_dir, like, step=step)
-    note = task_change_note(cfg.run_dir, meta["env"], env)
-    if note:
-        print(note, file=sys.stderr)
+    note_task_changes(cfg.run_dir, meta["env"], env)
     return env, trainer, state, step
 
 

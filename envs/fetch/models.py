@@ -102,14 +102,14 @@ def within_reach(grip, target, center, radius=ARM_REACH_RADIUS, stretch_gain=ARM
     return center + off * xp.minimum(1.0, radius / xp.maximum(dist, 1e-9))
 
 
-def workspace_box(kind: str, finger_table: float = 0.0):
+def workspace_box(kind: str, finger_table: float = 0.0, press: float = FINGER_PRESS):
     """World xyz (lo, hi) of the box the gripper target is clipped to: the table and 15 cm around it in
     xy, from the fingertips on the table top to 0.6 m above it. With a finger-table contact the floor is
-    ``FINGER_PRESS`` below the fingertips on the table: there the table, not the box, stops the gripper,
+    ``press`` below the fingertips on the table: there the table, not the box, stops the gripper,
     and a downward command presses it on the table and drags it as in the reference."""
     (tx, ty, _), (hx, hy, _), _ = _SCENES[kind]
     margin = 0.15
-    floor = TABLE_TOP + (REFERENCE_FINGER_BELOW_SITE - FINGER_PRESS if finger_table > 0 else FINGER_BELOW_SITE)
+    floor = TABLE_TOP + (REFERENCE_FINGER_BELOW_SITE - press if finger_table > 0 else FINGER_BELOW_SITE)
     return ((tx - hx - margin, ty - hy - margin, floor),
             (tx + hx + margin, ty + hy + margin, TABLE_TOP + 0.6))
 

@@ -32,11 +32,11 @@ def reference_path(action) -> np.ndarray:
     return np.array(path)
 
 
-def our_path(action, friction: float) -> np.ndarray:
+def our_path(action, friction: float, press: float) -> np.ndarray:
     m = mujoco.MjModel.from_xml_string(models.mjcf("push", timestep=0.004, finger_table=friction))
     d = mujoco.MjData(m)
-    lo, hi = models.workspace_box("push", friction)
-    home = np.array(models.build("push")[2].grip_home)
+    lo, hi = models.workspace_box("push", friction, press)
+    home = m.body("gripper").pos.copy()  # the grip site when the gripper joints are 0
     g, o = m.joint("grip_x").qposadr[0], m.joint("object").qposadr[0]
     d.qpos[o : o + 3] = [1.6, 0.4, 0.425]  # the cube out of the way
     mujoco.mj_forward(m, d)
@@ -62,10 +62,7 @@ def main() -> None:
     args = p.parse_args()
     print("| action | FetchPush-v4 | " + " | ".join(f"ours, press {x:g}" for x in args.press) + " |")
     for name, action in ACTIONS.items():
-        ours = []
-        for press in args.press:
-            models.FINGER_PRESS = press  # read by workspace_box
-            ours.append(per_step_mm(our_path(action, args.friction)))
+        ours = [per_step_mm(our_path(action, args.friction, press)) for press in args.press]
         print(f"| {name} | {per_step_mm(reference_path(action)):.1f} | " + " | ".join(f"{x:.1f}" for x in ours) + " |")
 
 

@@ -3,7 +3,7 @@ side, final-step success, episodes that reached the goal and lost it (of them: t
 the cube still moving), cubes off the table and still moving at the final step, and the share of steps
 with the grip below z 0.418 (the reference's fingers on its table).
 
-    python experiments/reference/trace_stats.py 'DIR/s*.npz'
+    PYTHONPATH=. python experiments/reference/trace_stats.py 'DIR/s*.npz'
 """
 
 from __future__ import annotations
@@ -13,7 +13,8 @@ import sys
 
 import numpy as np
 
-TABLE_TOP = 0.4
+from envs.fetch.models import TABLE_TOP
+
 MOVING = 0.02  # m/s
 FINGERS_ON_TABLE = 0.418
 

@@ -8,7 +8,6 @@ import dataclasses
 import io
 import json
 import os
-import sys
 
 import numpy as np
 
@@ -38,7 +37,7 @@ def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
     from splid_jax.learners.registry import make_algorithm
     from splid_jax.runtime import checkpoint
     from splid_jax.runtime.loop import make_env
-    from splid_jax.runtime.run_files import task_change_note
+    from splid_jax.runtime.run_files import note_task_changes
 
     directory, index, members = sweep
     env = make_env(cfg.env, **cfg.env_overrides())  # the member's task, with any changed fields
@@ -46,9 +45,7 @@ def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
         trainer = make_algorithm(TrainConfig.from_json(json.load(fh)["config"], run_dir=directory), env)
     like = jax.eval_shape(jax.vmap(trainer.init), jax.random.split(jax.random.PRNGKey(0), members))
     step, state, meta = checkpoint.restore(directory, like, step=step)
-    note = task_change_note(cfg.run_dir, meta.get("env", {}), env)
-    if note:
-        print(note, file=sys.stderr)
+    note_task_changes(cfg.run_dir, meta.get("env", {}), env)
     return env, trainer, jax.tree.map(lambda x: x[index], state), step
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import sys
 
 import envs
 from splid_jax.common.errors import InvalidConfig
@@ -24,15 +25,14 @@ def env_settings(env: envs.GoalEnv) -> dict:
     return json.loads(json.dumps(env.settings()))
 
 
-def task_change_note(run_dir: str, saved: dict, env: envs.GoalEnv) -> str | None:
-    """A line naming the task's options that differ from those a checkpoint recorded (``saved``): a
+def note_task_changes(run_dir: str, saved: dict, env: envs.GoalEnv) -> None:
+    """Name, on stderr, the task's options that differ from those a checkpoint recorded (``saved``): a
     policy is still worth a look under a changed task, so loaders say it rather than stop."""
     now = env_settings(env)
     changed = [k for k in now if saved.get(k) != now[k]]
-    if not changed:
-        return None
-    what = ", ".join(f"{k}={saved.get(k)!r} then, {now[k]!r} now" for k in changed)
-    return f"note: {run_dir} was trained on another version of the task ({what})"
+    if changed:
+        what = ", ".join(f"{k}={saved.get(k)!r} then, {now[k]!r} now" for k in changed)
+        print(f"note: {run_dir} was trained on another version of the task ({what})", file=sys.stderr)
 
 
 def identity(cfg: TrainConfig) -> dict:

@@ -14,6 +14,11 @@ HOLDING = ("hold", "settle", "stop")  # the relabellings that add held-goal cand
 GCSL_RELABELS = ("final", "future")
 
 
+def select_modes(relabel: str) -> dict[str, bool]:
+    """SELECT's keyword switches (``splid.select.select``) for a ``--relabel`` value."""
+    return {"hold": relabel in HOLDING, "settle": relabel == "settle", "stop": relabel == "stop"}
+
+
 @dataclasses.dataclass(frozen=True)
 class ImitationConfig:
     sigma: float

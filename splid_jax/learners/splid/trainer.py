@@ -19,7 +19,7 @@ from splid_jax.learners.base import Chunked
 from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.bc import bc_epoch
 from splid_jax.learners.imitation.candidates import Candidates
-from splid_jax.learners.imitation.config import HOLDING, ImitationConfig
+from splid_jax.learners.imitation.config import ImitationConfig, select_modes
 from splid_jax.learners.imitation.explore import Seen, draws, rollout
 from splid_jax.learners.splid.select import select
 from splid_jax.runtime.devices import ENVS
@@ -180,10 +180,8 @@ class Trainer(Chunked):
             horizon,
             bc.select,
             bc.select_lanes,
-            hold=bc.relabel in HOLDING,
-            settle=bc.relabel == "settle",
             radius=bc.select_radius,
-            stop=bc.relabel == "stop",
+            **select_modes(bc.relabel),
         )
         return traj.seen(), cands
 
