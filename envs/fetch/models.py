@@ -22,7 +22,9 @@ Every geom is a primitive with ``contype = conaffinity = 0``; the only collision
   table). MJX collides a cylinder with a sphere but not with a box, so the closed fingers strike it
   with four round corner tips. The gripper weighs 13 kg, the reference arm's effective mass at the
   grip site; lighter, it launches the puck too slowly.
-- ``finger="capsule"``: Push's finger block as a capsule, a cheaper contact (an option).
+- ``finger="pads"`` (Push's default): the block has the horizontal extent of the reference's two closed
+  finger pads at the cube's height (``PADS_HALF_XY``), so a push moves the cube as far as there;
+  ``"box"`` is a smaller block, ``"capsule"`` that block as a capsule, a cheaper contact.
 
 How these compare with the reference: ``experiments/parity/README.md``.
 """
@@ -45,6 +47,14 @@ REFERENCE_FINGER_BELOW_SITE = 0.019
 # How far below the fingertips-on-the-table height the target may go with that contact: the press that, at
 # the reference's finger friction 1, drags the gripper as the reference's mocap weld drags its fingers.
 FINGER_PRESS = 0.025
+# Half extents (x, y) of the reference's two closed finger pads taken together, cut at the cube's mid-height
+# (x -0.0139..0.0132, y -0.0160..0.0149 about its grip site): the closed finger block with ``finger="pads"``.
+PADS_HALF_XY = (0.0135, 0.0155)
+# Their contact with the cube as MuJoCo mixes the two geoms' (a pad: condim 4, friction 1 0.05 0.01, margin
+# 0.001, solref 0.01 1, solimp 0.99 0.99 0.01; the cube: the defaults): stiffer than the default contact,
+# with torsional friction, and active 1 mm before touching.
+PADS_OBJECT_CONTACT = ('condim="4" friction="1 1 0.05 0.01 0.01" margin="0.001" solref="0.015 1" '
+                       'solimp="0.945 0.97 0.0055 0.5 2"')
 GRIPPER_MASS = 4.0  # palm + fingers, the mass the xyz drive moves
 DRIVE_OMEGA = 50.0  # rad/s: the reference weld's time constant 0.02 s
 FINGER_KP = 30000.0
@@ -135,10 +145,10 @@ def tables_for(kind: str) -> tuple[str, ...]:
 
 
 def fingers_for(kind: str) -> tuple[str, ...]:
-    """Collision shapes of the closed finger block: Push may use a vertical capsule of the block's
-    height (radius 1.1 cm) instead of the box; Slide strikes with round tips, PickAndPlace grips with
-    two box fingers, Reach touches nothing."""
-    return ("box", "capsule") if kind == "push" else ("box",)
+    """Collision shapes of the closed finger block: Push may use the reference pads' extent
+    (``PADS_HALF_XY``), a smaller box, or a vertical capsule of the box's height (radius 1.1 cm); Slide
+    strikes with round tips, PickAndPlace grips with two box fingers, Reach touches nothing."""
+    return ("pads", "box", "capsule") if kind == "push" else ("box",)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -284,14 +294,19 @@ def mjcf(
             for n, _, _ in tips
         )
     else:
-        shape = 'type="capsule" size="0.011 0.019"' if finger == "capsule" else 'type="box" size="0.01 0.012 0.03"'
+        shape = {
+            "capsule": 'type="capsule" size="0.011 0.019"',
+            "box": 'type="box" size="0.01 0.012 0.03"',
+            "pads": f'type="box" size="{_fmt(*PADS_HALF_XY)} 0.03"',
+        }[finger]
         fingers = f"""
       <geom name="fingers" {shape} pos="0 0 {finger_z:.6g}" mass="0.001"
             {nograv} rgba="0.3 0.3 0.3 1"/>"""
         finger_act = ""
+        contact = PADS_OBJECT_CONTACT if finger == "pads" else f'condim="3" friction="{friction}"'
         finger_pairs = (
             f"""
-    <pair geom1="fingers" geom2="object" condim="3" friction="{friction}"/>"""
+    <pair geom1="fingers" geom2="object" {contact}/>"""
             if has_object
             else ""
         )

@@ -99,7 +99,7 @@ class _FetchTask(GoalEnv):
     # Parity-study options (experimental): the reference's variants of parts of the physics.
     # the table's collision shape: its top face as a plane, or the reference's box
     table: str = experimental("plane")
-    # the closed finger block's collision shape (Push: box or capsule, see models.py)
+    # the closed finger block's collision shape (Push: pads, box or capsule, see models.py)
     finger: str = experimental("box")
     # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     cholesky: str = experimental("unrolled")
@@ -357,9 +357,12 @@ class Reach(_FetchTask):
 class Push(_FetchTask):
     """Push a 5 cm cube to a goal on the table; fingers locked closed. The fingers touch the table
     (``finger_table``, the reference's friction 1): a policy trained where pressing down on the table
-    costs nothing presses there, and in the reference that drags its gripper and loses the cube."""
+    costs nothing presses there, and in the reference that drags its gripper and loses the cube. The finger
+    block has the reference pads' extent (``finger="pads"``): a smaller one pushes the cube less far per
+    command than the reference's, and a policy trained on it overshoots there."""
 
     finger_table: float = 1.0
+    finger: str = "pads"
     kind = "push"
 
 

@@ -226,6 +226,28 @@ def test_push_capsule_finger_replaces_the_box_in_the_same_pair():
     np.testing.assert_allclose(capsule.geom("fingers").size[0] + capsule.geom("fingers").size[1], 0.03)
 
 
+def _cube_moved_by_a_resting_gripper(finger: str, ahead: float) -> float:
+    """How far the cube moves in 0.2 s when put ``ahead`` m in front of the grip (x), the gripper held still."""
+    m = models.build("push", finger=finger)[0]
+    d = mujoco.MjData(m)
+    o, rest = m.joint("object").qposadr[0], models.build("push", finger=finger)[2].object_rest_z
+    start = m.body("gripper").pos[:2] + [ahead, 0.0]
+    d.qpos[o : o + 3] = [*start, rest]
+    for _ in range(50):
+        mujoco.mj_step(m, d)
+    return float(np.linalg.norm(d.qpos[o : o + 2] - start))
+
+
+def test_push_pads_finger_is_the_reference_pads_extent_and_meets_the_cube_first():
+    m = models.build("push", finger="pads")[0]
+    np.testing.assert_allclose(m.geom("fingers").size[:2], models.PADS_HALF_XY)
+    assert envs.make("push").finger == "pads"
+    # the cube 1 mm clear of the smaller box's face but inside the pads' face (and its contact margin)
+    ahead = models.OBJECT_HALF + 0.011
+    assert _cube_moved_by_a_resting_gripper("box", ahead) < 1e-4
+    assert _cube_moved_by_a_resting_gripper("pads", ahead) > 1e-3
+
+
 def test_slide_puck_is_a_cylinder_on_a_plane_struck_at_the_controller_corner():
     m = models.build("slide")[0]
     puck, table = m.geom("object"), m.geom("table")
