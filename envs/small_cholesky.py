@@ -30,7 +30,7 @@ MAX_UNROLLED = 16
 MIN_PIVOT = 1e-15  # mjMINVAL: MuJoCo's floor for a Cholesky pivot
 
 _LIBRARY = (jsl.cho_factor, jsl.cho_solve)
-_lock = threading.RLock()
+TRACE_LOCK = threading.RLock()  # held while MJX's functions are swapped for a trace (also solver_loops)
 
 
 def lower_factor(a: jax.Array) -> jax.Array:
@@ -103,7 +103,7 @@ def unrolled_in_mjx(enabled: bool = True):
     if not enabled:
         yield
         return
-    with _lock:
+    with TRACE_LOCK:
         saved = (jsl.cho_factor, jsl.cho_solve)
         jsl.cho_factor, jsl.cho_solve = cho_factor, cho_solve
         try:

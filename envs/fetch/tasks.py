@@ -32,7 +32,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs import small_cholesky
+from envs import small_cholesky, solver_loops
 from envs.base import GoalEnv, State, flag_invalid
 from envs.fetch import models
 from splid_jax.common.errors import check, check_integer
@@ -42,6 +42,7 @@ _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4)
 GOAL_LIFT_MAX = 0.45
 GRASP_ABOVE_SITE = 0.01  # a grasped cube's centre above the grip site: inside the fingers' 6 cm height
 CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
+SOLVER_LOOPS = ("loops", "unrolled")  # MJX's solver loops, or written out (envs/solver_loops.py)
 
 
 @struct.dataclass
@@ -103,6 +104,8 @@ class _FetchTask(GoalEnv):
     finger: str = experimental("box")
     # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     cholesky: str = experimental("unrolled")
+    # MJX's Newton solver as its loops or written out (envs/solver_loops.py): equal to float rounding
+    solver_loops: str = experimental("loops")
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
     # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
@@ -143,6 +146,8 @@ class _FetchTask(GoalEnv):
         check(self.workspace in spaces, f"{n}.workspace", self.workspace, "one of " + ", ".join(spaces))
         check(self.drive in models.DRIVES, f"{n}.drive", self.drive, "one of " + ", ".join(models.DRIVES))
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
+        ok = self.solver_loops in SOLVER_LOOPS
+        check(ok, f"{n}.solver_loops", self.solver_loops, "one of " + ", ".join(SOLVER_LOOPS))
         grasp_range = "in [0, 1]" if not self.block_gripper else "0 (the fingers are locked on this task)"
         ok = 0 <= self.grasped_starts <= 1 and (self.grasped_starts == 0 or not self.block_gripper)
         check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
@@ -322,8 +327,10 @@ class _FetchTask(GoalEnv):
         if self.drive == "weld":  # the constraint pulls the gripper to the mocap body, put at the target
             home = jnp.asarray(self.layout.grip_home, data.mocap_pos.dtype)
             data = data.replace(mocap_pos=data.mocap_pos.at[0].set(home + ctrl[0:3]))
+        written_out = self.solver_loops == "unrolled"
         with small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"):
-            data = jax.lax.fori_loop(0, self.substeps, lambda _, d: mjx.step(model, d), data)
+            with solver_loops.unrolled_in_mjx(self.iterations, written_out):
+                data = jax.lax.fori_loop(0, self.substeps, lambda _, d: mjx.step(model, d), data)
         return Physics(
             qpos=data.qpos, qvel=data.qvel, ctrl=data.ctrl, time=data.time, qacc_warmstart=data.qacc_warmstart
         )

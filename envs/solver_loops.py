@@ -1,0 +1,58 @@
+"""MJX's constraint solver with its loops written out: a fixed number of Newton iterations, each with a
+fixed number of line-search steps, and no loop left in the compiled step.
+
+Why: on a GPU every trip of an XLA loop reads its condition back to the host before the next trip, and
+an MJX step runs up to ``iterations`` Newton trips of ``ls_iterations`` line-search trips each. At the
+small batches SPLID and HER step (16 to 125 envs) those round trips, not arithmetic, may set the
+step's latency. Written out, each trip runs its body and keeps the result only where the loop would
+still be running (``jnp.where`` on the loop's own condition), so once converged a state stays as the
+loop left it: the same arithmetic as the loops, equal to float rounding. The price is compile time:
+the solver's body is traced ``iterations * (1 + ls_iterations)`` times.
+
+``unrolled_in_mjx()`` swaps the loops in for the duration of a trace, as ``small_cholesky`` does:
+``jax.lax.while_loop`` is replaced only for loops whose body is MJX's solver's (its module), and the
+solver's scan-based line-search loop by its written-out form.
+"""
+
+from __future__ import annotations
+
+import contextlib
+
+import jax
+import jax.numpy as jnp
+from mujoco.mjx._src import solver as mjx_solver
+
+from envs.small_cholesky import TRACE_LOCK
+
+_SOLVER_MODULE = mjx_solver.__name__
+
+
+def _written_out(cond, body, val, trips: int):
+    for _ in range(trips):
+        go = cond(val)
+        nxt = body(val)
+        val = jax.tree.map(lambda a, b: jnp.where(go, a, b), nxt, val)
+    return val
+
+
+@contextlib.contextmanager
+def unrolled_in_mjx(iterations: int, enabled: bool = True):
+    """Within the block, MJX's Newton loop runs ``iterations`` written-out trips and its line search
+    ``ls_iterations`` (MJX passes that count); other loops are left as they are."""
+    if not enabled:
+        yield
+        return
+    with TRACE_LOCK:
+        while_loop, line_search = jax.lax.while_loop, mjx_solver._while_loop_scan
+
+        def solver_while(cond, body, init):
+            if getattr(body, "__module__", None) != _SOLVER_MODULE:
+                return while_loop(cond, body, init)
+            return _written_out(cond, body, init, iterations)
+
+        jax.lax.while_loop = solver_while
+        mjx_solver._while_loop_scan = lambda cond, body, init, max_iter: _written_out(cond, body, init, max_iter)
+        try:
+            yield
+        finally:
+            jax.lax.while_loop, mjx_solver._while_loop_scan = while_loop, line_search
