@@ -44,7 +44,8 @@ def warm(chunk, state, hyper, chunks: int):
     return state, first_s
 
 
-def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int, warm_chunks: int) -> dict:
+def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int, warm_chunks: int,
+                 chunk_only: bool = False) -> dict:  # fmt: skip
     cfg = TrainConfig(env=env_name, env_options=env_options, run_dir="/tmp/stage-budget")
     env = make_env(cfg.env, **cfg.env_overrides())
     algo = make_algorithm(cfg, env)
@@ -56,6 +57,8 @@ def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: i
     rows["chunk"], _ = timed(chunk, state, hyper, repeats=chunk_repeats)
     rows["chunk"]["compile_s"] = max(first_s - rows["chunk"]["median_s"], 0.0)
     rows["chunk"]["iterations"] = cfg.eval_every
+    if chunk_only:
+        return {"config": cfg.to_json(), "stages": rows}
     pstate, key = state.policy, jax.random.PRNGKey(1)
     sigma, horizon = hyper.sigma, hyper.horizon
 
@@ -98,7 +101,8 @@ def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: i
     return {"config": {k: cfg.to_json()[k] for k in shown}, "stages": rows}
 
 
-def her_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int, warm_chunks: int) -> dict:
+def her_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int, warm_chunks: int,
+               chunk_only: bool = False) -> dict:  # fmt: skip
     cfg = TrainConfig(env=env_name, env_options=env_options, algo="her", run_dir="/tmp/stage-budget-her")
     env = make_env(cfg.env, **cfg.env_overrides())
     algo = make_algorithm(cfg, env)
@@ -109,6 +113,8 @@ def her_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int
     rows["chunk"], _ = timed(chunk, state, {}, repeats=chunk_repeats)
     rows["chunk"]["compile_s"] = max(first_s - rows["chunk"]["median_s"], 0.0)
     rows["chunk"]["iterations"] = cfg.eval_every
+    if chunk_only:
+        return {"config": cfg.to_json(), "stages": rows}
     key = jax.random.PRNGKey(1)
     rows["explore"], (episodes, valid, _) = timed(jax.jit(algo.explore), state.policy, key, repeats=repeats)
 
@@ -144,6 +150,7 @@ def main() -> None:
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--chunk-repeats", type=int, default=3, help="timed calls of the whole chunk")
     p.add_argument("--warm-chunks", type=int, default=1, help="chunks trained before timing (>= 1)")
+    p.add_argument("--chunk-only", action="store_true", help="time the whole chunk alone, not each stage")
     p.add_argument("--label", default="default", help="the variant's name (e.g. its XLA flags)")
     p.add_argument("--out", required=True)
     args = p.parse_args()
@@ -158,7 +165,7 @@ def main() -> None:
     budgets = {"splid": splid_budget, "her": her_budget}
     for name in args.algos:
         sizes = (args.repeats, args.chunk_repeats, max(1, args.warm_chunks))
-        result[name] = budgets[name](args.env, args.env_options, *sizes)
+        result[name] = budgets[name](args.env, args.env_options, *sizes, chunk_only=args.chunk_only)
         with open(args.out, "w") as fh:  # after each learner, so a cut call keeps what it measured
             json.dump(result, fh, indent=2)
         for stage, row in result[name]["stages"].items():
