@@ -31,7 +31,7 @@ def _written_out(cond, body, val, trips: int):
     for _ in range(trips):
         go = cond(val)
         nxt = body(val)
-        val = jax.tree.map(lambda a, b: jnp.where(go, a, b), nxt, val)
+        val = jax.tree.map(lambda a, b, go=go: jnp.where(go, a, b), nxt, val)
     return val
 
 

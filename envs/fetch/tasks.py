@@ -105,7 +105,7 @@ class _FetchTask(GoalEnv):
     # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     cholesky: str = experimental("unrolled")
     # MJX's Newton solver as its loops or written out (envs/solver_loops.py): equal to float rounding
-    solver_loops: str = experimental("loops")
+    solver_loops: str = dataclasses.field(default="loops", metadata={"experimental": True, "numerics_only": True})
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
     # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)

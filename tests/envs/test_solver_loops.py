@@ -47,3 +47,9 @@ def test_only_the_solvers_loops_are_swapped_and_only_inside_the_block():
         n = jax.jit(lambda x: jax.lax.while_loop(lambda i: i < 10, lambda i: i + 1, x))(jnp.int32(0))
     assert int(n) == 10
     assert jax.lax.while_loop is before
+
+
+def test_settings_record_the_written_out_solver_only_when_chosen():
+    # a run recorded before the option existed matches a task at its default
+    assert "solver_loops" not in envs.make("push").settings()
+    assert envs.make("push", solver_loops="unrolled").settings()["solver_loops"] == "unrolled"
