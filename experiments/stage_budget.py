@@ -34,14 +34,23 @@ from splid_jax.learners.splid.select import select
 from splid_jax.runtime.loop import make_env
 
 
-def warm(chunk, state, hyper, chunks: int):
-    """``chunks`` (>= 1) trained chunks, and the first one's time (compilation included)."""
+def chunk_row(algo, state, hyper, cfg: TrainConfig, chunk_repeats: int, warm_chunks: int):
+    """The whole chunk's timing row, after ``warm_chunks`` (>= 1) trained chunks (the first one's time,
+    compilation included, less the median is the compile time), and the state they left."""
+    chunk = jax.jit(algo.chunk)
     t0 = time.perf_counter()
     state, _ = jax.block_until_ready(chunk(state, hyper))
     first_s = time.perf_counter() - t0
-    for _ in range(chunks - 1):
+    for _ in range(warm_chunks - 1):
         state, _ = jax.block_until_ready(chunk(state, hyper))
-    return state, first_s
+    row, _ = timed(chunk, state, hyper, repeats=chunk_repeats)
+    row["compile_s"] = max(first_s - row["median_s"], 0.0)
+    row["iterations"] = cfg.eval_every
+    return row, state
+
+
+def shown(cfg: TrainConfig, *keys: str) -> dict:
+    return {k: cfg.to_json()[k] for k in ("env", "env_options", "num_envs", *keys, "eval_every")}
 
 
 def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int, warm_chunks: int,
@@ -51,14 +60,11 @@ def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: i
     algo = make_algorithm(cfg, env)
     hyper = algo.hyper()
     state = algo.init(jax.random.PRNGKey(0))
+    # trained first, so the policy moves the object and SELECT sees real work
     rows = {}
-    chunk = jax.jit(algo.chunk)
-    state, first_s = warm(chunk, state, hyper, warm_chunks)  # a policy that moves the object: SELECT sees real work
-    rows["chunk"], _ = timed(chunk, state, hyper, repeats=chunk_repeats)
-    rows["chunk"]["compile_s"] = max(first_s - rows["chunk"]["median_s"], 0.0)
-    rows["chunk"]["iterations"] = cfg.eval_every
+    rows["chunk"], state = chunk_row(algo, state, hyper, cfg, chunk_repeats, warm_chunks)
     if chunk_only:
-        return {"config": cfg.to_json(), "stages": rows}
+        return {"config": shown(cfg, "bc_steps"), "stages": rows}
     pstate, key = state.policy, jax.random.PRNGKey(1)
     sigma, horizon = hyper.sigma, hyper.horizon
 
@@ -97,8 +103,7 @@ def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: i
 
     rows["evaluate"], _ = timed(jax.jit(eval_fn), pstate, key, repeats=repeats)
     rows["evaluate"]["episodes"] = cfg.eval_episodes
-    shown = ("env", "env_options", "num_envs", "bc_steps", "eval_every")
-    return {"config": {k: cfg.to_json()[k] for k in shown}, "stages": rows}
+    return {"config": shown(cfg, "bc_steps"), "stages": rows}
 
 
 def her_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int, warm_chunks: int,
@@ -108,13 +113,9 @@ def her_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int
     algo = make_algorithm(cfg, env)
     state = algo.init(jax.random.PRNGKey(0))
     rows = {}
-    chunk = jax.jit(algo.chunk)
-    state, first_s = warm(chunk, state, {}, warm_chunks)
-    rows["chunk"], _ = timed(chunk, state, {}, repeats=chunk_repeats)
-    rows["chunk"]["compile_s"] = max(first_s - rows["chunk"]["median_s"], 0.0)
-    rows["chunk"]["iterations"] = cfg.eval_every
+    rows["chunk"], state = chunk_row(algo, state, {}, cfg, chunk_repeats, warm_chunks)
     if chunk_only:
-        return {"config": cfg.to_json(), "stages": rows}
+        return {"config": shown(cfg), "stages": rows}
     key = jax.random.PRNGKey(1)
     rows["explore"], (episodes, valid, _) = timed(jax.jit(algo.explore), state.policy, key, repeats=repeats)
 
@@ -139,7 +140,7 @@ def her_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int
 
     rows["evaluate"], _ = timed(jax.jit(eval_fn), state.policy, key, repeats=repeats)
     rows["evaluate"]["episodes"] = cfg.eval_episodes
-    return {"config": {k: cfg.to_json()[k] for k in ("env", "env_options", "num_envs", "eval_every")}, "stages": rows}
+    return {"config": shown(cfg), "stages": rows}
 
 
 def main() -> None:

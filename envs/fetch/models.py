@@ -364,7 +364,7 @@ def mjcf(
 """
 
 
-def _rest_height(m: mujoco.MjModel, object_q: int) -> float:
+def rest_height(m: mujoco.MjModel, object_q: int) -> float:
     """Height at which the object comes to rest on the table (contacts are soft: it sinks a little)."""
     d = mujoco.MjData(m)
     for _ in range(int(round(1.0 / m.opt.timestep))):
@@ -389,7 +389,7 @@ def build(kind: str, **options):
     object_v = int(jnt("object").dofadr[0]) if kind != "reach" else None
     home = _SCENES[kind][2]
     lo, hi = workspace_box(kind, options.get("finger_table", 0.0))
-    rest_z = _rest_height(m, object_q) if object_q is not None else None
+    rest_z = rest_height(m, object_q) if object_q is not None else None
     layout = Layout(
         grip_q=grip_q,
         finger_q=finger_q,

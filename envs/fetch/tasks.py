@@ -80,9 +80,10 @@ def quat_rotate(q: jax.Array, v: jax.Array) -> jax.Array:
     return v + 2.0 * jnp.cross(u, jnp.cross(u, v) + w * v)
 
 
-def experimental(default):
-    """A task field ``--help`` marks as experimental: the parity study's variants, training-only starts."""
-    return dataclasses.field(default=default, metadata={"experimental": True})
+def experimental(default, **metadata):
+    """A task field ``--help`` marks as experimental: the parity study's variants, training-only starts;
+    ``metadata`` adds flags (``numerics_only``: see ``GoalEnv.settings``)."""
+    return dataclasses.field(default=default, metadata={"experimental": True, **metadata})
 
 
 @dataclasses.dataclass(frozen=True)
@@ -105,7 +106,7 @@ class _FetchTask(GoalEnv):
     # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     cholesky: str = experimental("unrolled")
     # MJX's Newton solver as its loops or written out (envs/solver_loops.py): equal to float rounding
-    solver_loops: str = dataclasses.field(default="loops", metadata={"experimental": True, "numerics_only": True})
+    solver_loops: str = experimental("loops", numerics_only=True)
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
     # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)

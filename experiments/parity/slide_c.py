@@ -67,7 +67,7 @@ def run(
     jac = np.zeros((3, m.nv))
     home = np.asarray(models._SCENES["slide"][2])
     lo, hi = models.workspace_box("slide")
-    rest_z = models._rest_height(m, o)
+    rest_z = models.rest_height(m, o)
     reach_center = models.ARM_REACH_CENTER["slide"] if workspace == "arm" else None
     obj_xy, goal_xy = starts(episodes, seed) if ep_starts is None else ep_starts
     goal = np.concatenate([goal_xy, np.full((episodes, 1), rest_z)], axis=1)

@@ -38,6 +38,8 @@ def _yaw(quat) -> float:
 def reference_pushes() -> np.ndarray:
     """[cases, 3]: the cube's x-y displacement and turn about z."""
     env = make_reference("push")
+    from gymnasium_robotics.utils import mujoco_utils
+
     out = []
     for angle, side, speed in CASES:
         o, _ = env.reset(seed=0)
@@ -48,7 +50,7 @@ def reference_pushes() -> np.ndarray:
             a = speed * ahead if t < HOLD else np.zeros(2)
             o, *_ = env.step(np.array([*a, 0.0, 0.0]))
         u = env.unwrapped
-        q = u.data.qpos[u.model.jnt_qposadr[u.model.joint("object0:joint").id] :][:7]
+        q = mujoco_utils.get_joint_qpos(u.model, u.data, "object0:joint")
         out.append([*(o["observation"][3:5] - first), _yaw(q[3:7])])
     env.close()
     return np.array(out)
@@ -60,7 +62,7 @@ def our_pushes(finger: str) -> np.ndarray:
     lo, hi = models.workspace_box("push", 1.0)
     home = m.body("gripper").pos.copy()  # the grip site when the gripper joints are 0
     g, o = m.joint("grip_x").qposadr[0], m.joint("object").qposadr[0]
-    rest = models.build("push", finger=finger, finger_table=1.0)[2].object_rest_z
+    rest = models.rest_height(m, o)
     out = []
     for angle, side, speed in CASES:
         mujoco.mj_resetData(m, d)

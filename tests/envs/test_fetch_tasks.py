@@ -228,9 +228,9 @@ def test_push_capsule_finger_replaces_the_box_in_the_same_pair():
 
 def _cube_moved_by_a_resting_gripper(finger: str, ahead: float) -> float:
     """How far the cube moves in 0.2 s when put ``ahead`` m in front of the grip (x), the gripper held still."""
-    m = models.build("push", finger=finger)[0]
+    m, _, layout = models.build("push", finger=finger)
     d = mujoco.MjData(m)
-    o, rest = m.joint("object").qposadr[0], models.build("push", finger=finger)[2].object_rest_z
+    o, rest = layout.object_q, layout.object_rest_z
     start = m.body("gripper").pos[:2] + [ahead, 0.0]
     d.qpos[o : o + 3] = [*start, rest]
     for _ in range(50):
