@@ -72,7 +72,17 @@ def traces(env, trainer: Trainer, pstate, key, episodes: int) -> dict:
     }
 
 
-def run_arm(env_name: str, seeds: int, base: dict, fields: dict, trace_episodes: int, first_seed: int = 1000) -> dict:
+def arm_path(out: str, env_name: str, fields: dict) -> str:
+    name = "-".join(f"{k}{v}" for k, v in fields.items()) or "default"
+    name = "".join(c if c.isalnum() or c in "._-" else "_" for c in name)  # a file name, whatever the values
+    return os.path.join(out, f"{env_name}-{name}.json")
+
+
+def run_arm(
+    env_name: str, seeds: int, base: dict, fields: dict, trace_episodes: int, first_seed: int = 1000, path: str = ""
+) -> dict:
+    """Trains the arm; with ``path``, its record so far is rewritten there after every evaluation, so
+    a run stopped early still leaves its curve."""
     merged = {**base, **fields}
     her = typed_fields(HerConfig, {k[4:]: v for k, v in merged.items() if k.startswith("her_")}, "set.her")
     train = typed_fields(TrainConfig, {k: v for k, v in merged.items() if not k.startswith("her_")}, "set")
@@ -87,6 +97,16 @@ def run_arm(env_name: str, seeds: int, base: dict, fields: dict, trace_episodes:
     t0 = time.perf_counter()
     compiled = chunk.lower(state, hyper).compile()
     compile_s = time.perf_counter() - t0
+    record = {
+        "env": env_name,
+        "fields": fields,
+        "config": cfg.to_json(),
+        "seeds": seeds,
+        "first_seed": first_seed,
+        "device": jax.devices()[0].device_kind,
+        "date": time.strftime("%Y-%m-%d"),
+        "compile_s": compile_s,
+    }
     curve, t0 = [], time.perf_counter()
     for it in range(cfg.eval_every, cfg.iterations + 1, cfg.eval_every):
         state, m = compiled(state, hyper)
@@ -105,18 +125,14 @@ def run_arm(env_name: str, seeds: int, base: dict, fields: dict, trace_episodes:
             f"final {np.mean(last['eval_success_final']):.3f} wall {last['wall_s']:.1f}s",
             flush=True,
         )
+        if path:
+            with open(path, "w") as fh:
+                json.dump({**record, "curve": curve, "traces": None}, fh)
     tr = jax.jit(jax.vmap(lambda ps, k: traces(env, trainer, ps, k, trace_episodes)))(
         state.policy, jax.random.split(jax.random.PRNGKey(7), seeds)
     )
     return {
-        "env": env_name,
-        "fields": fields,
-        "config": cfg.to_json(),
-        "seeds": seeds,
-        "first_seed": first_seed,
-        "device": jax.devices()[0].device_kind,
-        "date": time.strftime("%Y-%m-%d"),
-        "compile_s": compile_s,
+        **record,
         "curve": curve,
         "traces": {k: np.asarray(v).tolist() for k, v in jax.device_get(tr).items()},
     }
@@ -143,6 +159,8 @@ def figure(results: list[dict], out: str) -> None:
             mean, sem = y.mean(1), y.std(1, ddof=1) / np.sqrt(y.shape[1]) if y.shape[1] > 1 else 0 * y.mean(1)
             ax[0].plot(ep, mean, style, color=color, label=f"{label} ({name})")
             ax[0].fill_between(ep, mean - sem, mean + sem, color=color, alpha=0.2)
+        if r["traces"] is None:  # an arm stopped before its traces
+            continue
         steps = np.arange(1, len(r["traces"]["success_per_step"][0]) + 1)
         ax[1].plot(steps, np.mean(r["traces"]["success_per_step"], 0), color=color, label=label)
         ax[2].plot(steps, np.mean(r["traces"]["distance_median_per_step"], 0), color=color, label=label)
@@ -182,10 +200,10 @@ def main() -> None:
         base["iterations"] = a.iterations
     results = []
     for spec in a.set or [""]:
-        r = run_arm(a.env, a.seeds, base, parse_set(spec), a.trace_episodes, a.first_seed)
-        name = "-".join(f"{k}{v}" for k, v in r["fields"].items()) or "default"
-        name = "".join(c if c.isalnum() or c in "._-" else "_" for c in name)  # a file name, whatever the values
-        with open(os.path.join(a.out, f"{a.env}-{name}.json"), "w") as fh:
+        fields = parse_set(spec)
+        path = arm_path(a.out, a.env, fields)
+        r = run_arm(a.env, a.seeds, base, fields, a.trace_episodes, a.first_seed, path)
+        with open(path, "w") as fh:
             json.dump(r, fh)
         results.append(r)
         t = r["traces"]

@@ -73,6 +73,11 @@ class TrainConfig:
         None, "iterations over which sigma anneals to sigma_end x sigma, which it keeps from then on"
     )
     horizon: int = field(8, "learning horizon H: hindsight goals come from 1..H steps ahead")
+    hold_horizon: int = field(
+        0,
+        "hold, settle, stop: steps over which a held-goal candidate is judged (its goal is the object's place "
+        "that many steps on); 0: H. Below H it shortens those replays, which dominate SELECT's work at a long H",
+    )
     algo: str = field("splid", "learner: " + ", ".join(f"{x.name} ({x.summary})" for x in registry.LEARNERS.values()))
     select: bool = field(True, "SELECT by first hit time; --no-select stores every relabelled pair (ablation)")
     relabel: str = field(

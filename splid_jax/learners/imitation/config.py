@@ -25,6 +25,7 @@ class ImitationConfig:
     sigma_end: float
     sigma_anneal: int
     horizon: int
+    hold_horizon: int
     select: bool
     relabel: str
     select_radius: float
@@ -49,6 +50,12 @@ class ImitationConfig:
         check(0 <= self.sigma_end <= 1, "sigma_end", self.sigma_end, "in [0, 1] (a fraction of sigma)")
         check(self.sigma_anneal >= 1, "sigma_anneal", self.sigma_anneal, "an integer >= 1")
         check(self.horizon >= 1, "horizon", self.horizon, "an integer >= 1 (and < the episode length)")
+        check(
+            0 <= self.hold_horizon <= self.horizon,
+            "hold_horizon",
+            self.hold_horizon,
+            f"an integer in [0, {self.horizon}] (0: the learning horizon H; at most H)",
+        )
         check(0 < self.select_lanes <= 1, "select_lanes", self.select_lanes, "in (0, 1]")
         check(self.buffer_size >= 1, "buffer_size", self.buffer_size, "an integer >= 1")
         check(self.batch_size >= 1, "batch_size", self.batch_size, "an integer >= 1")

@@ -142,6 +142,7 @@ def select(
     settle: bool = False,
     radius: float = 1.0,
     stop: bool = False,
+    hold_horizon: int = 0,
 ) -> Candidates:
     """``max_horizon`` fixes the shapes; ``horizon`` (traced, <= max_horizon) masks the candidates
     of larger h, so runs with different H share one compiled program. ``use_select=False`` is the
@@ -152,7 +153,9 @@ def select(
     H steps (or to the episode's end), and judges every candidate at its final step: the explored
     actions are imitated where they leave the object at g' and the policy does not. ``radius`` scales
     the task's success threshold for every test here (``within``). ``stop`` (with ``hold``) labels the
-    held candidates with the zero action (module docstring)."""
+    held candidates with the zero action (module docstring). ``hold_horizon`` (> 0) takes the held
+    candidates at that h instead of H: at a long H their replays, one per explored step, would
+    outweigh every other."""
     T, H = env.episode_length, max_horizon
     n = traj.actions.shape[1]
     hs = jnp.arange(1, H + 1)
@@ -162,7 +165,8 @@ def select(
     real = (t[None, :] + hs[:, None] <= T)[..., None] & ~traj.invalid[:T][None] & ~traj.invalid[later]
     achieved_at_t = within(env, traj.achieved[:T][None], goal, radius)
     moved = real & ~achieved_at_t & (hs <= horizon)[:, None, None]  # Algorithm 2's candidates
-    held = real & achieved_at_t & (hs == horizon)[:, None, None] & hold
+    hold_at = horizon if hold_horizon == 0 else jnp.minimum(horizon, hold_horizon)
+    held = real & achieved_at_t & (hs == hold_at)[:, None, None] & hold
     if settle:
         after = jnp.minimum(later[..., None] + jnp.arange(1, H + 1), T)  # [H, T, H] the steps after t + h
         stays = jnp.all(within(env, traj.achieved[after], goal[:, :, None], radius), axis=2)

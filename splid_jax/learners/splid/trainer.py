@@ -181,6 +181,7 @@ class Trainer(Chunked):
             bc.select,
             bc.select_lanes,
             radius=bc.select_radius,
+            hold_horizon=bc.hold_horizon,
             **select_modes(bc.relabel),
         )
         return traj.seen(), cands

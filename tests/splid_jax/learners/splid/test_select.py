@@ -31,19 +31,20 @@ def policy(env):
 @pytest.fixture(scope="module")
 def run_select(env, policy):
     """``run_select(pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False,
-    radius=1.0, stop=False)``: SELECT, jitted once per setting."""
+    radius=1.0, stop=False, hold_horizon=0)``: SELECT, jitted once per setting."""
 
     @functools.cache
     def jitted(*static):
-        use_select, lanes, hold, settle, radius, stop = static
-        return jax.jit(
-            lambda ps, tr, hz: select(
-                env, policy, ps, tr, H, hz, use_select, lanes, hold=hold, settle=settle, radius=radius, stop=stop
-            )
-        )
+        use_select, lanes, hold, settle, radius, stop, hold_horizon = static
+        modes = dict(hold=hold, settle=settle, radius=radius, stop=stop, hold_horizon=hold_horizon)
+        return jax.jit(lambda ps, tr, hz: select(env, policy, ps, tr, H, hz, use_select, lanes, **modes))
 
-    def run(pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False, radius=1.0, stop=False):
-        return jitted(use_select, lanes, hold, settle, radius, stop)(pstate, traj, jnp.int32(horizon))
+    def run(
+        pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False, radius=1.0, stop=False,
+        hold_horizon=0,
+    ):  # fmt: skip
+        static = (use_select, lanes, hold, settle, radius, stop, hold_horizon)
+        return jitted(*static)(pstate, traj, jnp.int32(horizon))
 
     return run
 
@@ -189,6 +190,23 @@ def test_held_goals_are_kept_where_the_policy_leaves_them_and_judged_at_the_fina
     assert bool(policy_reaches(env, policy, drift, there, goal, H)) and not bool(
         policy_reaches(env, policy, drift, there, goal, H, at_final=True)
     )
+
+
+def test_hold_horizon_judges_the_held_goals_that_many_steps_on(env, policy, run_select):
+    """``hold_horizon=2``: the held candidates are those at h = 2 (at most the horizon), each replayed
+    2 steps; the moved ones are untouched. Above the run's horizon it falls back to H."""
+    traj = scripted_trajectory(env, [[0.0, 0.4]], start=(-2.0, -4.8))  # env 0 moves, the others stand still
+    hs, ts = np.arange(1, H + 1)[:, None, None], np.arange(T)[None, :, None]
+    drift = constant_policy(policy, [1.0, 0.0])
+    full, short = run_select(drift, traj, hold=True), run_select(drift, traj, hold=True, hold_horizon=2)
+    standing = env_of(short.held)[..., 1:]
+    np.testing.assert_array_equal(standing, np.broadcast_to((hs == 2) & (ts + hs <= T), standing.shape))
+    np.testing.assert_array_equal(short.accept, short.held | (np.asarray(full.accept) & ~np.asarray(full.held)))
+    assert int(short.held.sum()) > int(full.held.sum())  # h = 2 fits more steps before the episode's end
+    moved = np.asarray(full.valid) & ~np.asarray(full.held)
+    assert moved.any() and int(short.replay_steps) < int(full.replay_steps)
+    np.testing.assert_array_equal(run_select(drift, traj, 3, hold=True, hold_horizon=4).held, run_select(
+        drift, traj, 3, hold=True).held)
 
 
 def test_stop_labels_the_held_pairs_with_the_zero_action_and_keeps_the_rest(env, policy, run_select):
