@@ -83,10 +83,11 @@ class TrainConfig:
     relabel: str = field(
         None,
         "splid/pchid candidates: paper (Algorithm 2 exactly), hold (also steps whose goal is already "
-        "achieved and held for H steps, kept when the policy is not at the goal after H steps) or settle "
+        "achieved and held for H steps, kept when the policy is not at the goal after H steps), settle "
         "(experimental: hold, and a moved goal only where the object then stays there H steps; every "
-        "verdict at the final step) or stop (hold, with the held pairs labelled by the zero action: stand still "
-        "at a reached goal)",
+        "verdict at the final step), rest (settle with one moved goal per explored step: the latest h "
+        "at which the object rests there, so a strike's resting place is one candidate, not one per h) "
+        "or stop (hold, with the held pairs labelled by the zero action: stand still at a reached goal)",
     )
     select_radius: float = field(
         1.0,

@@ -9,14 +9,15 @@ import dataclasses
 
 from splid_jax.common.errors import check
 
-RELABELS = ("paper", "hold", "settle", "stop")
-HOLDING = ("hold", "settle", "stop")  # the relabellings that add held-goal candidates
+RELABELS = ("paper", "hold", "settle", "rest", "stop")
+HOLDING = ("hold", "settle", "rest", "stop")  # the relabellings that add held-goal candidates
 GCSL_RELABELS = ("final", "future")
 
 
 def select_modes(relabel: str) -> dict[str, bool]:
     """SELECT's keyword switches (``splid.select.select``) for a ``--relabel`` value."""
-    return {"hold": relabel in HOLDING, "settle": relabel == "settle", "stop": relabel == "stop"}
+    settle = relabel in ("settle", "rest")
+    return {"hold": relabel in HOLDING, "settle": settle, "rest": relabel == "rest", "stop": relabel == "stop"}
 
 
 @dataclasses.dataclass(frozen=True)

@@ -143,6 +143,7 @@ def select(
     radius: float = 1.0,
     stop: bool = False,
     hold_horizon: int = 0,
+    rest: bool = False,
 ) -> Candidates:
     """``max_horizon`` fixes the shapes; ``horizon`` (traced, <= max_horizon) masks the candidates
     of larger h, so runs with different H share one compiled program. ``use_select=False`` is the
@@ -155,7 +156,9 @@ def select(
     the task's success threshold for every test here (``within``). ``stop`` (with ``hold``) labels the
     held candidates with the zero action (module docstring). ``hold_horizon`` (> 0) takes the held
     candidates at that h instead of H: at a long H their replays, one per explored step, would
-    outweigh every other."""
+    outweigh every other. ``rest`` (with ``settle``) keeps, of each explored step's settled moved
+    candidates, only the one of largest h: their goals all lie within the threshold of one resting
+    place, so the others would replay the same question with less time to answer it."""
     T, H = env.episode_length, max_horizon
     n = traj.actions.shape[1]
     hs = jnp.arange(1, H + 1)
@@ -171,6 +174,8 @@ def select(
         after = jnp.minimum(later[..., None] + jnp.arange(1, H + 1), T)  # [H, T, H] the steps after t + h
         stays = jnp.all(within(env, traj.achieved[after], goal[:, :, None], radius), axis=2)
         moved = moved & stays
+        if rest:  # none settled at a larger h for the same step
+            moved = moved & (jnp.flip(jnp.cumsum(jnp.flip(moved, 0), 0), 0) == 1)
     at_final = (held | (moved & settle)).reshape(-1)
     valid, held = (moved | held).reshape(-1), held.reshape(-1)
     goal = goal.reshape(H * T * n, -1)

@@ -31,19 +31,19 @@ def policy(env):
 @pytest.fixture(scope="module")
 def run_select(env, policy):
     """``run_select(pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False,
-    radius=1.0, stop=False, hold_horizon=0)``: SELECT, jitted once per setting."""
+    radius=1.0, stop=False, hold_horizon=0, rest=False)``: SELECT, jitted once per setting."""
 
     @functools.cache
     def jitted(*static):
-        use_select, lanes, hold, settle, radius, stop, hold_horizon = static
-        modes = dict(hold=hold, settle=settle, radius=radius, stop=stop, hold_horizon=hold_horizon)
+        use_select, lanes, hold, settle, radius, stop, hold_horizon, rest = static
+        modes = dict(hold=hold, settle=settle, radius=radius, stop=stop, hold_horizon=hold_horizon, rest=rest)
         return jax.jit(lambda ps, tr, hz: select(env, policy, ps, tr, H, hz, use_select, lanes, **modes))
 
     def run(
         pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False, radius=1.0, stop=False,
-        hold_horizon=0,
+        hold_horizon=0, rest=False,
     ):  # fmt: skip
-        static = (use_select, lanes, hold, settle, radius, stop, hold_horizon)
+        static = (use_select, lanes, hold, settle, radius, stop, hold_horizon, rest)
         return jitted(*static)(pstate, traj, jnp.int32(horizon))
 
     return run
@@ -243,3 +243,19 @@ def test_settle_keeps_moved_goals_where_the_object_then_stays_and_radius_scales_
     np.testing.assert_array_equal(settled.accept, settled.valid)
     # every kept candidate, moved or held (the standing-still envs' h = H ones), runs its full h
     assert int(settled.replay_steps) == int((hs[..., None] * env_of(settled.valid)).sum()) > int((hs * want).sum())
+
+
+def test_rest_keeps_one_settled_goal_per_step_the_latest(env, policy, run_select):
+    """``rest``: of the settle test's candidates (t + h >= T - 3, h >= 4) each step t keeps only its
+    largest h, so a step asks once where the object came to rest; held candidates are unchanged."""
+    traj = scripted_trajectory(env, [[0.0, 0.3]])
+    drift = constant_policy(policy, [1.0, 0.0])
+    hs, ts = np.arange(1, H + 1)[:, None], np.arange(T)[None, :]
+    settled = run_select(drift, traj, hold=True, settle=True)
+    once = run_select(drift, traj, hold=True, settle=True, rest=True)
+    want = (hs >= 4) & (ts + hs >= T - 3) & (ts + hs <= T)
+    latest = want & (hs == np.minimum(H, T - ts))
+    assert latest.any() and (want & ~latest).any()
+    np.testing.assert_array_equal(env_of(once.valid)[..., 0], latest)
+    np.testing.assert_array_equal(once.held, settled.held)
+    np.testing.assert_array_equal(once.accept, once.valid)
