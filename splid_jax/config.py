@@ -78,6 +78,11 @@ class TrainConfig:
         "hold, settle, stop: steps over which a held-goal candidate is judged (its goal is the object's place "
         "that many steps on); 0: H. Below H it shortens those replays, which dominate SELECT's work at a long H",
     )
+    rest_horizon: int = field(
+        0,
+        "rest: 0 looks for resting places within H; above H, Algorithm 2's goals keep H and resting places "
+        "are looked for up to rest_horizon steps ahead (below the episode length)",
+    )
     algo: str = field("splid", "learner: " + ", ".join(f"{x.name} ({x.summary})" for x in registry.LEARNERS.values()))
     select: bool = field(True, "SELECT by first hit time; --no-select stores every relabelled pair (ablation)")
     relabel: str = field(
@@ -209,6 +214,12 @@ class TrainConfig:
             "horizon",
             self.horizon,
             f"an integer in [1, {env.episode_length - 1}] (below the episode length)",
+        )
+        check(
+            self.rest_horizon < env.episode_length,
+            "rest_horizon",
+            self.rest_horizon,
+            f"an integer in [0, {env.episode_length - 1}] (below the episode length)",
         )
 
     def to_json(self) -> dict[str, Any]:

@@ -36,7 +36,7 @@ class Learner:
 
 IMITATION_FIELDS = tuple(f.name for f in dataclasses.fields(ImitationConfig))
 # SELECT's settings, read by SPLID and PCHID; GCSL clones every relabelled pair and selects nothing
-SELECT_FIELDS = ("horizon", "hold_horizon", "select", "relabel", "select_radius", "select_lanes")
+SELECT_FIELDS = ("horizon", "hold_horizon", "rest_horizon", "select", "relabel", "select_radius", "select_lanes")
 _CLONING = tuple(f for f in IMITATION_FIELDS if f not in (*SELECT_FIELDS, "gcsl_relabel", "pchid_every"))
 _TRAINER = "splid_jax.learners.splid.trainer:Trainer"
 _IMITATION = dict(settings=ImitationConfig, splits_envs=True, sweeps=("sigma", "horizon"))

@@ -48,3 +48,23 @@ def test_pchid_schedule_is_resolved_once_so_a_longer_resume_keeps_it():
 def test_sigma_schedule_outside_its_range_names_the_field(field, value):
     with pytest.raises(InvalidConfig, match=field):
         TrainConfig(env="point", **{field: value})
+
+
+@pytest.mark.parametrize(
+    "fields",
+    [
+        {"hold_horizon": -1},
+        {"hold_horizon": 9},  # above the horizon 8
+        {"rest_horizon": 16},  # without relabel=rest
+        {"rest_horizon": 8, "relabel": "rest"},  # not above the horizon
+    ],
+)
+def test_select_horizons_outside_their_range_name_the_field(fields):
+    name = next(k for k in fields if k.endswith("horizon"))
+    with pytest.raises(InvalidConfig, match=name):
+        TrainConfig(env="point", **fields)
+
+
+def test_rest_horizon_within_the_episode_is_accepted():
+    cfg = TrainConfig(env="point", relabel="rest", horizon=4, rest_horizon=16, hold_horizon=2)
+    assert (cfg.rest_horizon, cfg.hold_horizon) == (16, 2)

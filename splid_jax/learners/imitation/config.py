@@ -27,6 +27,7 @@ class ImitationConfig:
     sigma_anneal: int
     horizon: int
     hold_horizon: int
+    rest_horizon: int
     select: bool
     relabel: str
     select_radius: float
@@ -56,6 +57,12 @@ class ImitationConfig:
             "hold_horizon",
             self.hold_horizon,
             f"an integer in [0, {self.horizon}] (0: the learning horizon H; at most H)",
+        )
+        check(
+            self.rest_horizon == 0 or (self.relabel == "rest" and self.rest_horizon > self.horizon),
+            "rest_horizon",
+            self.rest_horizon,
+            f"0, or with relabel=rest an integer above the horizon {self.horizon}",
         )
         check(0 < self.select_lanes <= 1, "select_lanes", self.select_lanes, "in (0, 1]")
         check(self.buffer_size >= 1, "buffer_size", self.buffer_size, "an integer >= 1")

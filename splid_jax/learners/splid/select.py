@@ -144,6 +144,7 @@ def select(
     stop: bool = False,
     hold_horizon: int = 0,
     rest: bool = False,
+    rest_horizon: int = 0,
 ) -> Candidates:
     """``max_horizon`` fixes the shapes; ``horizon`` (traced, <= max_horizon) masks the candidates
     of larger h, so runs with different H share one compiled program. ``use_select=False`` is the
@@ -158,7 +159,10 @@ def select(
     candidates at that h instead of H: at a long H their replays, one per explored step, would
     outweigh every other. ``rest`` (with ``settle``) keeps, of each explored step's settled moved
     candidates, only the one of largest h: their goals all lie within the threshold of one resting
-    place, so the others would replay the same question with less time to answer it."""
+    place, so the others would replay the same question with less time to answer it. ``rest_horizon``
+    (> 0, with ``rest``; ``max_horizon`` covers it) keeps Algorithm 2's candidates within ``horizon``
+    and adds resting places up to ``rest_horizon`` steps ahead, judged at their final step: a strike
+    and where it leaves the object can lie further apart than the steps a first hit is learnt over."""
     T, H = env.episode_length, max_horizon
     n = traj.actions.shape[1]
     hs = jnp.arange(1, H + 1)
@@ -167,16 +171,19 @@ def select(
     goal = traj.achieved[later]  # [H, T, N, G]
     real = (t[None, :] + hs[:, None] <= T)[..., None] & ~traj.invalid[:T][None] & ~traj.invalid[later]
     achieved_at_t = within(env, traj.achieved[:T][None], goal, radius)
-    moved = real & ~achieved_at_t & (hs <= horizon)[:, None, None]  # Algorithm 2's candidates
+    away = real & ~achieved_at_t
+    moved = away & (hs <= horizon)[:, None, None]  # Algorithm 2's candidates
     hold_at = horizon if hold_horizon == 0 else jnp.minimum(horizon, hold_horizon)
     held = real & achieved_at_t & (hs == hold_at)[:, None, None] & hold
+    settled = jnp.zeros_like(moved)
     if settle:
         after = jnp.minimum(later[..., None] + jnp.arange(1, H + 1), T)  # [H, T, H] the steps after t + h
         stays = jnp.all(within(env, traj.achieved[after], goal[:, :, None], radius), axis=2)
-        moved = moved & stays
+        settled = (moved if rest_horizon == 0 else away) & stays
         if rest:  # none settled at a larger h for the same step
-            moved = moved & (jnp.flip(jnp.cumsum(jnp.flip(moved, 0), 0), 0) == 1)
-    at_final = (held | (moved & settle)).reshape(-1)
+            settled = settled & (jnp.flip(jnp.cumsum(jnp.flip(settled, 0), 0), 0) == 1)
+        moved = settled if rest_horizon == 0 else moved | settled
+    at_final = (held | settled).reshape(-1)
     valid, held = (moved | held).reshape(-1), held.reshape(-1)
     goal = goal.reshape(H * T * n, -1)
     if use_select:

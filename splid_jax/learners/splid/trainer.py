@@ -59,7 +59,8 @@ class Trainer(Chunked):
         cfg.check_env(env)
         self.env, self.cfg, self.bc, self.name = env, cfg, bc, cfg.algo
         self.learner = registry.get(cfg.algo)
-        self.max_horizon = bc.horizon  # shapes; a sweep's members mask larger h through Hyper.horizon
+        # shapes; a sweep's members mask larger h through Hyper.horizon
+        self.max_horizon = max(bc.horizon, bc.rest_horizon)
         self.pchid_every = max(1, bc.pchid_every)  # TrainConfig resolves 0 for pchid
         self.policy = make_policy(
             env.obs_size,
@@ -182,6 +183,7 @@ class Trainer(Chunked):
             bc.select_lanes,
             radius=bc.select_radius,
             hold_horizon=bc.hold_horizon,
+            rest_horizon=bc.rest_horizon,
             **select_modes(bc.relabel),
         )
         return traj.seen(), cands

@@ -31,19 +31,20 @@ def policy(env):
 @pytest.fixture(scope="module")
 def run_select(env, policy):
     """``run_select(pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False,
-    radius=1.0, stop=False, hold_horizon=0, rest=False)``: SELECT, jitted once per setting."""
+    radius=1.0, stop=False, hold_horizon=0, rest=False, rest_horizon=0)``: SELECT, jitted once per setting."""
 
     @functools.cache
     def jitted(*static):
-        use_select, lanes, hold, settle, radius, stop, hold_horizon, rest = static
+        use_select, lanes, hold, settle, radius, stop, hold_horizon, rest, rest_horizon = static
         modes = dict(hold=hold, settle=settle, radius=radius, stop=stop, hold_horizon=hold_horizon, rest=rest)
+        modes["rest_horizon"] = rest_horizon
         return jax.jit(lambda ps, tr, hz: select(env, policy, ps, tr, H, hz, use_select, lanes, **modes))
 
     def run(
         pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False, radius=1.0, stop=False,
-        hold_horizon=0, rest=False,
+        hold_horizon=0, rest=False, rest_horizon=0,
     ):  # fmt: skip
-        static = (use_select, lanes, hold, settle, radius, stop, hold_horizon, rest)
+        static = (use_select, lanes, hold, settle, radius, stop, hold_horizon, rest, rest_horizon)
         return jitted(*static)(pstate, traj, jnp.int32(horizon))
 
     return run
@@ -259,3 +260,22 @@ def test_rest_keeps_one_settled_goal_per_step_the_latest(env, policy, run_select
     np.testing.assert_array_equal(env_of(once.valid)[..., 0], latest)
     np.testing.assert_array_equal(once.held, settled.held)
     np.testing.assert_array_equal(once.accept, once.valid)
+
+
+def test_rest_horizon_adds_resting_places_beyond_the_horizon_to_algorithm_2s_goals(env, policy, run_select):
+    """``rest_horizon=5`` at horizon 3 (radius 0.5: a goal is away from h = 2 on): Algorithm 2's
+    candidates within 3 steps, and each step's latest resting place within 5, every one of them
+    replayed its full h by a policy that never gets there; held goals at h = 3."""
+    traj = scripted_trajectory(env, [[0.0, 0.3]])
+    drift = constant_policy(policy, [1.0, 0.0])
+    paper = run_select(drift, traj, horizon=3, radius=0.5)
+    rested = run_select(drift, traj, hold=True, settle=True, rest=True, radius=0.5)
+    both = run_select(drift, traj, horizon=3, hold=True, settle=True, rest=True, rest_horizon=5, radius=0.5)
+    moved = lambda c: env_of(np.asarray(c.valid) & ~np.asarray(c.held))[..., 0]  # noqa: E731
+    want = moved(paper) | moved(rested)
+    assert (want & ~moved(paper)).any() and (want & ~moved(rested)).any()
+    np.testing.assert_array_equal(moved(both), want)
+    np.testing.assert_array_equal(both.held, run_select(drift, traj, horizon=3, hold=True, radius=0.5).held)
+    np.testing.assert_array_equal(both.accept, both.valid)
+    hs = np.arange(1, H + 1)[:, None, None]
+    assert int(both.replay_steps) == int((hs * env_of(both.valid)).sum())
