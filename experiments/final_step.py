@@ -152,7 +152,9 @@ def figure(results: list[dict], out: str) -> None:
     fig, ax = plt.subplots(1, 3, figsize=(15, 4))
     for i, r in enumerate(results):
         color = f"C{i}"
-        label = ",".join(f"{k}={v}" for k, v in r["fields"].items()) or r["config"].get("algo", "default")
+        cfg = r["config"]  # an arm without fields of its own is named by its base's learner and relabelling
+        own = ",".join(f"{k}={v}" for k, v in r["fields"].items())
+        label = own or f"{cfg.get('algo')}, relabel={cfg.get('relabel')}"
         ep = [c["episodes"] for c in r["curve"]]
         for key, style, name in (("eval_success", "-", "any step"), ("eval_success_final", "--", "final step")):
             y = np.array([c[key] for c in r["curve"]])
@@ -170,7 +172,8 @@ def figure(results: list[dict], out: str) -> None:
     for a in ax:
         a.legend(fontsize=7)
         a.grid(alpha=0.3)
-    fig.suptitle(f"{results[0]['env']}: {results[0]['seeds']} seeds, {results[0]['device']}, {results[0]['date']}")
+    dates = "/".join(sorted({r["date"] for r in results}))
+    fig.suptitle(f"{results[0]['env']}: {results[0]['seeds']} seeds, {results[0]['device']}, {dates}")
     fig.tight_layout()
     fig.savefig(out, dpi=110)
 
