@@ -27,10 +27,8 @@ from splid_jax.common.evaluation import evaluate
 from splid_jax.config import TrainConfig
 from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.bc import bc_epoch
-from splid_jax.learners.imitation.config import select_modes
 from splid_jax.learners.imitation.explore import draws, rollout
 from splid_jax.learners.registry import make_algorithm
-from splid_jax.learners.splid.select import select
 from splid_jax.runtime.loop import make_env
 
 
@@ -75,10 +73,7 @@ def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: i
     rows["explore"], traj = timed(jax.jit(explore_fn), pstate, key, repeats=repeats)
 
     def select_fn(pstate, traj):
-        return select(
-            env, algo.policy, pstate, traj, algo.max_horizon, horizon, cfg.select, cfg.select_lanes,
-            radius=cfg.select_radius, **select_modes(cfg.relabel),
-        )  # fmt: skip
+        return algo.select(pstate, traj, horizon)
 
     rows["select"], cands = timed(jax.jit(select_fn), pstate, traj, repeats=repeats)
     rows["select"]["replay_steps"] = int(cands.replay_steps)

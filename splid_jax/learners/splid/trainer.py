@@ -20,7 +20,7 @@ from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.bc import bc_epoch
 from splid_jax.learners.imitation.candidates import Candidates
 from splid_jax.learners.imitation.config import ImitationConfig, select_modes
-from splid_jax.learners.imitation.explore import Seen, draws, rollout
+from splid_jax.learners.imitation.explore import Seen, Trajectory, draws, rollout
 from splid_jax.learners.splid.select import select
 from splid_jax.runtime.devices import ENVS
 
@@ -168,12 +168,16 @@ class Trainer(Chunked):
         return seen, Candidates(*whole, jax.lax.psum(cands.replay_steps, ENVS))
 
     def _explore_and_select(self, pstate, reset_keys, noise, sigma, horizon) -> tuple[Seen, Candidates | None]:
-        env, bc = self.env, self.bc
-        traj = rollout(env, self.policy, pstate, reset_keys, noise, sigma)
+        traj = rollout(self.env, self.policy, pstate, reset_keys, noise, sigma)
         if self.learner.clones_every_pair:
             return traj.seen(), None
-        cands = select(
-            env,
+        return traj.seen(), self.select(pstate, traj, horizon)
+
+    def select(self, pstate, traj: Trajectory, horizon: jax.Array) -> Candidates:
+        """SELECT over one exploration's relabelled candidates, as this run's settings ask for."""
+        bc = self.bc
+        return select(
+            self.env,
             self.policy,
             pstate,
             traj,
@@ -186,7 +190,6 @@ class Trainer(Chunked):
             rest_horizon=bc.rest_horizon,
             **select_modes(bc.relabel),
         )
-        return traj.seen(), cands
 
     def sigma_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
         """This iteration's exploration noise: sigma, falling linearly to sigma_end x sigma over the
