@@ -209,18 +209,10 @@ class TrainConfig:
 
     def check_env(self, env: envs.GoalEnv) -> None:
         """Checks that need the task's sizes."""
-        check(
-            self.horizon < env.episode_length,
-            "horizon",
-            self.horizon,
-            f"an integer in [1, {env.episode_length - 1}] (below the episode length)",
-        )
-        check(
-            self.rest_horizon < env.episode_length,
-            "rest_horizon",
-            self.rest_horizon,
-            f"an integer in [0, {env.episode_length - 1}] (below the episode length)",
-        )
+        last = env.episode_length - 1
+        for name, lowest in (("horizon", 1), ("rest_horizon", 0)):
+            value = getattr(self, name)
+            check(value <= last, name, value, f"an integer in [{lowest}, {last}] (below the episode length)")
 
     def to_json(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
