@@ -30,22 +30,15 @@ def policy(env):
 
 @pytest.fixture(scope="module")
 def run_select(env, policy):
-    """``run_select(pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False,
-    radius=1.0, stop=False, hold_horizon=0, rest=False, rest_horizon=0)``: SELECT, jitted once per setting."""
+    """``run_select(pstate, traj, horizon=H, use_select=True, lanes=1.0, **modes)``: SELECT with
+    ``select``'s keyword settings ``modes`` (hold, settle, radius, ...), jitted once per setting."""
 
     @functools.cache
-    def jitted(*static):
-        use_select, lanes, hold, settle, radius, stop, hold_horizon, rest, rest_horizon = static
-        modes = dict(hold=hold, settle=settle, radius=radius, stop=stop, hold_horizon=hold_horizon, rest=rest)
-        modes["rest_horizon"] = rest_horizon
-        return jax.jit(lambda ps, tr, hz: select(env, policy, ps, tr, H, hz, use_select, lanes, **modes))
+    def jitted(use_select, lanes, modes):
+        return jax.jit(lambda ps, tr, hz: select(env, policy, ps, tr, H, hz, use_select, lanes, **dict(modes)))
 
-    def run(
-        pstate, traj, horizon=H, use_select=True, lanes=1.0, hold=False, settle=False, radius=1.0, stop=False,
-        hold_horizon=0, rest=False, rest_horizon=0,
-    ):  # fmt: skip
-        static = (use_select, lanes, hold, settle, radius, stop, hold_horizon, rest, rest_horizon)
-        return jitted(*static)(pstate, traj, jnp.int32(horizon))
+    def run(pstate, traj, horizon=H, use_select=True, lanes=1.0, **modes):
+        return jitted(use_select, lanes, tuple(sorted(modes.items())))(pstate, traj, jnp.int32(horizon))
 
     return run
 
