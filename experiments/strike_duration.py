@@ -13,43 +13,30 @@ import io
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent))
+sys.path.insert(1, str(HERE / "parity"))
 
 import jax  # noqa: E402
 import numpy as np  # noqa: E402
+from run_ours import rollout_fn  # noqa: E402  (the parity study's scripted episodes)
 
 import envs  # noqa: E402
-from envs.fetch import scripted  # noqa: E402
+from envs.fetch.scripted import CONTROLLERS  # noqa: E402
 
-CONTROLLERS = {"push": scripted.push, "slide": scripted.slide, "pick_and_place": scripted.pick_and_place}
-
-
-def moves(env, controller, episodes: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """Per episode: the achieved goal at every step [E, T + 1, G] and success at the final step [E]."""
-
-    def one(key):
-        s0 = env.reset(key)
-
-        def body(state, _):
-            nxt = env.step(state, controller(state.obs, state.desired_goal))
-            return nxt, (nxt.achieved_goal, nxt.success)
-
-        _, (achieved, success) = jax.lax.scan(body, s0, None, length=env.episode_length)
-        return jax.numpy.concatenate([s0.achieved_goal[None], achieved]), success[-1]
-
-    run = jax.jit(lambda key: jax.vmap(one)(jax.random.split(key, episodes)))
-    return jax.device_get(run(jax.random.PRNGKey(seed)))
+TASKS = ("push", "slide", "pick_and_place")  # the tasks with an object to strike
 
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
-    p.add_argument("--env", default="slide", choices=sorted(CONTROLLERS))
+    p.add_argument("--env", default="slide", choices=TASKS)
     p.add_argument("--episodes", type=int, default=32)
     p.add_argument("--seed", type=int, default=0)
     a = p.parse_args()
     with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
         env = envs.make(a.env)
-    achieved, final = moves(env, CONTROLLERS[a.env], a.episodes, a.seed)
+    out = jax.device_get(rollout_fn(env, CONTROLLERS[a.env], a.episodes)(jax.random.PRNGKey(a.seed)))
+    achieved, final = np.concatenate([out["start"][:, None], out["achieved"]], axis=1), out["success_final"]
     step = np.linalg.norm(np.diff(achieved, axis=1), axis=-1)  # [E, T]
     durations = []
     for e in range(a.episodes):

@@ -34,7 +34,8 @@ TASKS = ("push", "slide", "pick_and_place", "reach")
 
 
 def rollout_fn(env, controller, episodes: int):
-    """A jitted ``key -> per-episode arrays`` running ``episodes`` scripted episodes in lock step."""
+    """A jitted ``key -> per-episode arrays`` running ``episodes`` scripted episodes in lock step (the
+    achieved goal after every step too, for ``experiments/strike_duration.py``)."""
     horizon = env.episode_length
 
     def one(key):
@@ -45,9 +46,9 @@ def rollout_fn(env, controller, episodes: int):
             if obs.shape[-1] != 25:  # Reach: pad its 10 floats to the 25-float layout (grip first)
                 obs = jnp.concatenate([obs[:3], jnp.zeros(22, obs.dtype)])
             nxt = env.step(state, controller(obs, state.desired_goal))
-            return nxt, (nxt.success, nxt.invalid)
+            return nxt, (nxt.success, nxt.invalid, nxt.achieved_goal)
 
-        last, (succ, invalid) = jax.lax.scan(body, s0, None, length=horizon)
+        last, (succ, invalid, achieved) = jax.lax.scan(body, s0, None, length=horizon)
         return {
             "success_any": jnp.any(succ),
             "success_final": succ[-1],
@@ -55,6 +56,7 @@ def rollout_fn(env, controller, episodes: int):
             "start": s0.achieved_goal,
             "goal": s0.desired_goal,
             "final": last.achieved_goal,
+            "achieved": achieved,  # after each step
         }
 
     return jax.jit(lambda key: jax.vmap(one)(jax.random.split(key, episodes)))
