@@ -16,6 +16,8 @@ import jax.extend.core
 import jax.numpy as jnp
 import pytest
 
+pytest_plugins = ("tests.hang_watchdog",)  # a test that hangs ends its worker, with every stack logged
+
 # XLA:CPU's fusion emitters cost about a third of each compile here, and the suite is mostly
 # compilation; without them the programs compute the same up to float rounding (every comparison in
 # the suite is between runs made under the same flags). Known to jaxlib 0.10; other versions run as is,
