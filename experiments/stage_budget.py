@@ -26,7 +26,6 @@ from bench_splid import timed  # this folder's scripts share their timer
 from splid_jax.common.evaluation import evaluate
 from splid_jax.config import TrainConfig
 from splid_jax.learners.imitation import relabel_buffer
-from splid_jax.learners.imitation.bc import bc_epoch
 from splid_jax.learners.imitation.explore import draws, rollout
 from splid_jax.learners.registry import make_algorithm
 from splid_jax.runtime.loop import make_env
@@ -85,10 +84,7 @@ def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: i
     rows["insert"], buf = timed(jax.jit(insert_fn), state.buffer, cands, repeats=repeats)
 
     def bc_fn(pstate, opt_state, online, buf, key):
-        return bc_epoch(
-            algo.policy, algo.optimiser, pstate, opt_state, buf, key, cfg.bc_steps, cfg.batch_size,
-            online=online, ema=cfg.policy_ema,
-        )  # fmt: skip
+        return algo.clone(pstate, opt_state, online, buf, key, hyper)
 
     rows["bc"], _ = timed(jax.jit(bc_fn), pstate, state.opt_state, state.online, buf, key, repeats=repeats)
     rows["bc"]["steps"] = cfg.bc_steps

@@ -1,8 +1,10 @@
-"""``python -m splid_jax.sweep``: seeds x sigma x H as ONE compiled program.
+"""``python -m splid_jax.sweep``: seeds x sigma x H (x any other traced setting, ``--vary``) as ONE
+compiled program.
 
 Every member is a lane of ``jax.vmap`` over the chunk function (``splid_jax.runtime.loop``): seeds differ by
-PRNG key, sigma and H by the traced hyper-parameters (H masks candidates up to the largest H of the
-grid), so a grid costs one compilation and runs in lock-step on the device. Each member writes its
+PRNG key, sigma, H and the ``--vary`` settings (a learner's ``sweeps`` in the registry: the noise's end,
+Adam's rate, the acting average's decay) by the traced hyper-parameters (H masks candidates up to the
+largest H of the grid), so a grid costs one compilation and runs in lock-step on the device. Each member writes its
 own config.json and metrics.jsonl under RUN_DIR/<member>; the members' stacked state is checkpointed
 under RUN_DIR, so ``--resume RUN_DIR`` continues a sweep as it continues a run."""
 
@@ -52,31 +54,52 @@ class Member:
     seed: int
     sigma: float
     horizon: int
+    settings: tuple[tuple[str, float], ...] = ()  # the --vary fields' values, in the order given
 
     @property
     def name(self) -> str:
-        return f"sigma{self.sigma:g}-H{self.horizon}-s{self.seed}"
+        varied = "".join(f"-{field}{value:g}" for field, value in self.settings)
+        return f"sigma{self.sigma:g}-H{self.horizon}{varied}-s{self.seed}"
 
 
-def members(seeds: int, sigmas: tuple[float, ...], horizons: tuple[int, ...], base_seed: int = 0) -> list[Member]:
+def members(
+    seeds: int,
+    sigmas: tuple[float, ...],
+    horizons: tuple[int, ...],
+    base_seed: int = 0,
+    varied: dict[str, tuple[float, ...]] | None = None,
+) -> list[Member]:
+    """Every combination of sigma, H and the ``varied`` fields' values, each on ``seeds`` seeds."""
+    varied = varied or {}
     check(seeds >= 1, "seeds", seeds, "an integer >= 1")
     ok = len(sigmas) >= 1 and all(math.isfinite(s) and s >= 0 for s in sigmas)
     check(ok, "sigmas", sigmas, "one or more finite values >= 0")
     check(len(horizons) >= 1 and min(horizons) >= 1, "horizons", horizons, "one or more integers >= 1")
-    for name, values in (("sigmas", sigmas), ("horizons", horizons)):  # two members would share one directory
+    for name, values in (("sigmas", sigmas), ("horizons", horizons), *varied.items()):  # one directory each
         check(len(set(values)) == len(values), name, ",".join(map(str, values)), "distinct values")
-    return [Member(base_seed + s, float(sg), int(h)) for sg, h, s in itertools.product(sigmas, horizons, range(seeds))]
+    points = itertools.product(sigmas, horizons, *varied.values(), range(seeds))
+    return [Member(base_seed + p[-1], float(p[0]), int(p[1]), tuple(zip(varied, p[2:-1], strict=True))) for p in points]
 
 
 def member_configs(cfg: TrainConfig, grid: list[Member]) -> tuple[TrainConfig, list[TrainConfig]]:
-    """The sweep's config (shapes for the largest H) and each member's, in RUN_DIR/<member>."""
-    base = dataclasses.replace(cfg, horizon=max(m.horizon for m in grid))
+    """The sweep's config (shapes for the largest H; the largest value of each varied field, so an
+    acting average is kept when any member has one) and each member's, in RUN_DIR/<member>."""
+    largest = {field: max(dict(m.settings)[field] for m in grid) for field, _ in grid[0].settings}
+    base = dataclasses.replace(cfg, horizon=max(m.horizon for m in grid), **largest)
     lanes = [
         dataclasses.replace(
-            base, seed=m.seed, sigma=m.sigma, horizon=m.horizon, run_dir=os.path.join(cfg.run_dir, m.name)
+            base,
+            seed=m.seed,
+            sigma=m.sigma,
+            horizon=m.horizon,
+            run_dir=os.path.join(cfg.run_dir, m.name),
+            **dict(m.settings),
         )
         for m in grid
     ]
+    points = {(m.sigma, m.horizon, m.settings): lane for m, lane in zip(grid, lanes, strict=True)}
+    for lane in points.values():  # each grid point's settings in their ranges, before any work
+        lane.learner_config()
     return base, lanes
 
 
@@ -115,7 +138,8 @@ def _join_negative(argv: list[str]) -> list[str]:
 def build_parser() -> Parser:
     parser = Parser(
         prog="python -m splid_jax.sweep",
-        description="Run a grid of seeds x sigma x H as one vmapped, compiled program; one metrics file per member.",
+        description="Run a grid of seeds x sigma x H (x --vary settings) as one vmapped, compiled program; one "
+        "metrics file per member.",
         epilog="Exit codes as train's: 0 done, 2 bad input (nothing written), 3 stopped, 130 Ctrl-C, 143 SIGTERM.",
     )
     # --sigmas and --horizons replace the single values
@@ -125,6 +149,14 @@ def build_parser() -> Parser:
     parser.add_argument("--seeds", type=int, default=None, help="seeds per grid point (default: 4)")
     parser.add_argument("--sigmas", default=None, help="comma-separated sigma values (default: 1.0)")
     parser.add_argument("--horizons", default=None, help="comma-separated H values (default: 8)")
+    parser.add_argument(
+        "--vary",
+        action="append",
+        metavar="FIELD=V1,V2",
+        help="one more traced setting to grid over, e.g. learning_rate=0.0005,0.001 (repeatable; the fields: "
+        + ", ".join(f for f in _sweepable("splid"))
+        + ")",
+    )
     parser.add_argument("--resume", metavar="RUN_DIR", help="continue the sweep saved in RUN_DIR (its sweep.json)")
     parser.add_argument("--no-plot", action="store_true", help="skip the grid figure")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
@@ -137,6 +169,25 @@ def build_parser() -> Parser:
     add_compile_cache_flag(parser)
     add_launch_flags(parser)
     return parser
+
+
+def _sweepable(algo: str) -> tuple[str, ...]:
+    """The traced settings ``--vary`` takes for ``algo``: its sweeps but sigma and H (their own flags)."""
+    return tuple(f for f in registry.get(algo).sweeps if f not in ("sigma", "horizon"))
+
+
+def varied_values(items: list[str] | None, algo: str) -> dict[str, tuple[float, ...]]:
+    """``--vary FIELD=V1,V2`` items as ``{field: values}``, each field one of ``algo``'s traced settings."""
+    out: dict[str, tuple[float, ...]] = {}
+    allowed = _sweepable(algo)
+    for item in items or ():
+        field, sep, text = (x.strip() for x in item.partition("="))
+        if not sep or field not in allowed or field in out:
+            fields = ", ".join(allowed) or f"none: --algo {algo} traces no setting but sigma and H"
+            raise InvalidConfig("vary", item, f"FIELD=V1,V2 with FIELD one of {fields}, each field once")
+        out[field] = _values(field, text, float)
+        check(all(map(math.isfinite, out[field])), field, text, "finite numbers")
+    return out
 
 
 def resume_configs(run_dir: str, given: dict) -> tuple[TrainConfig, list[TrainConfig]]:
@@ -158,12 +209,20 @@ def resume_configs(run_dir: str, given: dict) -> tuple[TrainConfig, list[TrainCo
     return base, lanes
 
 
-def check_same_grid(lanes: list[TrainConfig], seeds: int | None, sigmas: str | None, horizons: str | None) -> None:
+def check_same_grid(
+    lanes: list[TrainConfig],
+    seeds: int | None,
+    sigmas: str | None,
+    horizons: str | None,
+    varied: dict[str, tuple[float, ...]] | None = None,
+) -> None:
     """A resumed sweep trains the grid it started with: a grid flag given anew must name that grid."""
     first = {"seeds": len({m.seed for m in lanes}), "sigmas": tuple(dict.fromkeys(m.sigma for m in lanes)),
              "horizons": tuple(dict.fromkeys(m.horizon for m in lanes))}  # fmt: skip
     given = {"seeds": seeds, "sigmas": None if sigmas is None else _values("sigmas", sigmas, float),
              "horizons": None if horizons is None else _values("horizons", horizons, int)}  # fmt: skip
+    for field, values in (varied or {}).items():
+        first[field], given[field] = tuple(dict.fromkeys(getattr(m, field) for m in lanes)), values
     for name, value in given.items():
         if value is not None and value != first[name]:
             shown = ",".join(map(str, first[name])) if isinstance(first[name], tuple) else first[name]
@@ -179,7 +238,7 @@ def main(argv: list[str] | None = None) -> int:
         given = explicit_values(TrainConfig, ns)
         if ns.resume:  # its sweep.json: process 0's
             cfg, lanes = multihost.from_first(lambda: resume_configs(ns.resume, given))
-            check_same_grid(lanes, ns.seeds, ns.sigmas, ns.horizons)
+            check_same_grid(lanes, ns.seeds, ns.sigmas, ns.horizons, varied_values(ns.vary, cfg.algo))
         else:
             algo = given.get("algo", "splid")
             refuse_unread(given, algo)
@@ -190,7 +249,10 @@ def main(argv: list[str] | None = None) -> int:
             sigmas = _values("sigmas", "1.0" if ns.sigmas is None else ns.sigmas, float)
             horizons = _values("horizons", "8" if ns.horizons is None else ns.horizons, int)
             seeds = 4 if ns.seeds is None else ns.seeds
-            grid = members(seeds, sigmas, horizons, base_seed=given.get("seed", 0))
+            varied = varied_values(ns.vary, algo)
+            for field in varied.keys() & given.keys():
+                raise InvalidConfig(field, given[field], f"given once: either --{field.replace('_', '-')} or --vary")
+            grid = members(seeds, sigmas, horizons, base_seed=given.get("seed", 0), varied=varied)
             cfg, lanes = member_configs(TrainConfig(**{**given, "horizon": max(horizons), "sigma": max(sigmas)}), grid)
         env = make_env(cfg.env, **cfg.env_overrides())
         cfg.check_env(env)

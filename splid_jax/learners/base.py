@@ -26,8 +26,9 @@ class Algorithm(Protocol):
     def init(self, key: jax.Array) -> Any:
         """The whole training state as a pytree with an ``iteration`` leaf ([] int32, completed iterations)."""
 
-    def hyper(self) -> Any:
-        """Settings a sweep may vary per member, as a pytree of traced scalars (``{}`` when none)."""
+    def hyper(self, cfg: Any = None) -> Any:
+        """The settings a sweep may vary per member (the registry's ``sweeps``) as a pytree of traced
+        scalars (``{}`` when none), from ``cfg`` (a member's config) or the learner's own."""
 
     def chunk(self, state: Any, hyper: Any) -> tuple[Any, dict]:
         """Pure: ``cfg.eval_every`` iterations, then one evaluation of the deterministic policy.

@@ -39,7 +39,11 @@ IMITATION_FIELDS = tuple(f.name for f in dataclasses.fields(ImitationConfig))
 SELECT_FIELDS = ("horizon", "hold_horizon", "rest_horizon", "select", "relabel", "select_radius", "select_lanes")
 _CLONING = tuple(f for f in IMITATION_FIELDS if f not in (*SELECT_FIELDS, "gcsl_relabel", "pchid_every"))
 _TRAINER = "splid_jax.learners.splid.trainer:Trainer"
-_IMITATION = dict(settings=ImitationConfig, splits_envs=True, sweeps=("sigma", "horizon"))
+_IMITATION = dict(
+    settings=ImitationConfig,
+    splits_envs=True,
+    sweeps=("sigma", "horizon", "sigma_end", "learning_rate", "policy_ema"),
+)
 # HER on the Fetch tasks runs as OpenAI Baselines: a cycle explores 2 episodes on each of 8 workers
 # (num_envs 16, with HerConfig's batch of 2048 = 8 x 256 averaged gradients) and an epoch of 50 cycles
 # is evaluated (eval_every 50). Push's 1,250 cycles are 20,000 episodes; Slide's and PickAndPlace's

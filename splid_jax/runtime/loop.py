@@ -76,20 +76,14 @@ def placement(cfg: TrainConfig, members: int | None, algo: Algorithm | None = No
 
 
 def _lane_hyper(algo: Algorithm, base: TrainConfig, lane: TrainConfig) -> Any:
-    """``algo.hyper()`` with each leaf named after a config field set to the member's value. A member
-    may differ from the sweep's config only in its seed, its run_dir and such fields."""
-    hyper = algo.hyper()
-    names = [f.name for f in dataclasses.fields(hyper)] if dataclasses.is_dataclass(hyper) else list(hyper)
+    """``algo.hyper(lane)``: a member may differ from the sweep's config only in its seed, its run_dir
+    and the learner's traced settings (its registry entry's ``sweeps``)."""
+    traced = registry.get(base.algo).sweeps
     for f in dataclasses.fields(TrainConfig):
-        if f.name not in ("seed", "run_dir", *names) and getattr(lane, f.name) != getattr(base, f.name):
+        if f.name not in ("seed", "run_dir", *traced) and getattr(lane, f.name) != getattr(base, f.name):
             allowed = f"{getattr(base, f.name)!r} in every member of a sweep of {algo.name} (not a traced setting)"
             raise InvalidConfig(f.name, getattr(lane, f.name), allowed)
-    values = {n: jnp.asarray(getattr(lane, n), jnp.asarray(_get(hyper, n)).dtype) for n in names if hasattr(lane, n)}
-    return hyper.replace(**values) if dataclasses.is_dataclass(hyper) else {**hyper, **values}
-
-
-def _get(tree, name):
-    return tree[name] if isinstance(tree, dict) else getattr(tree, name)
+    return algo.hyper(lane)
 
 
 def _canonical(tree, sharding):

@@ -1,4 +1,5 @@
-"""A grid of seeds x sigma x H runs as one vmapped program and writes one metrics file per member."""
+"""A grid of seeds x sigma x H (x --vary's traced settings) runs as one vmapped program and writes one
+metrics file per member."""
 
 import json
 
@@ -27,6 +28,52 @@ def test_grid_runs_as_one_program_with_a_file_per_member(tmp_path):
     assert by_name["sigma1-H4-s0"] != by_name["sigma1-H4-s1"]  # seeds differ
     config = json.loads((tmp_path / "sigma0-H2-s1" / "config.json").read_text())
     assert (config["sigma"], config["horizon"], config["seed"]) == (0.0, 2, 1)
+
+
+def test_vary_grids_over_traced_settings_in_one_program(tmp_path):
+    args = ["--env", "point", "--num-envs", "4", "--eval-episodes", "8", "--iterations", "2", "--eval-every", "2",
+            "--bc-steps", "5", "--batch-size", "16", "--hidden", "16", "--seeds", "1", "--horizons", "4",
+            "--no-plot", "--quiet", "--run-dir", str(tmp_path)]  # fmt: skip
+    vary = ["--vary", "learning_rate=0.001,0.1", "--vary", "policy_ema=0,0.9"]
+    assert sweep.main([*args, *vary]) == 0
+    names = sorted(p.name for p in tmp_path.iterdir() if p.is_dir() and p.name != "checkpoints")
+    grid = [(lr, ema) for lr in ("0.001", "0.1") for ema in ("0", "0.9")]
+    assert names == [f"sigma1-H4-learning_rate{lr}-policy_ema{ema}-s0" for lr, ema in grid]
+    config = json.loads((tmp_path / names[1] / "config.json").read_text())
+    assert (config["learning_rate"], config["policy_ema"]) == (0.001, 0.9)
+    base = json.loads((tmp_path / "sweep.json").read_text())["config"]
+    assert (base["learning_rate"], base["policy_ema"]) == (0.1, 0.9)  # the acting average kept for all
+    losses = {n: read(tmp_path / n / "metrics.jsonl")[-1]["bc_loss"] for n in names}
+    assert len(set(losses.values())) == 4  # each member trains with its own rate and average
+
+
+@pytest.mark.parametrize(
+    "vary, field",
+    [
+        ("horizon=2,4", "vary"),  # H has its own flag
+        ("learning_rate", "vary"),
+        ("batch_size=16,32", "vary"),  # a shape, not a traced setting
+        ("learning_rate=a,b", "learning_rate"),
+        ("learning_rate=-1,0.1", "learning_rate"),
+        ("learning_rate=inf", "learning_rate"),
+        ("policy_ema=0.5,0.5", "policy_ema"),
+        ("sigma_end=0.5,2", "sigma_end"),
+    ],
+)
+def test_vary_names_the_field_of_a_bad_value(capsys, tmp_path, vary, field):
+    assert sweep.main(["--env", "point", "--vary", vary, "--run-dir", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+    assert not (tmp_path / "x").exists()
+
+
+def test_vary_refuses_a_field_given_twice_or_one_the_learner_does_not_trace(capsys, tmp_path):
+    for args, field in [(["--learning-rate", "0.001", "--vary", "learning_rate=0.001,0.01"], "learning_rate"),
+                        (["--algo", "her", "--vary", "learning_rate=0.001,0.01"], "vary")]:  # fmt: skip
+        assert sweep.main(["--env", "point", *args, "--run-dir", str(tmp_path / "x")]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+    assert not (tmp_path / "x").exists()
 
 
 def test_cli_rejects_a_bad_grid(capsys, tmp_path):
@@ -88,7 +135,8 @@ def test_a_second_sweep_into_one_dir_is_refused_and_a_sweep_resumes(capsys, tmp_
     assert sweep.main([*args, "--iterations", "4", "--sigmas", "0.5", "--run-dir", run_dir]) == 2
     assert "run_dir" in capsys.readouterr().err
     assert read(tmp_path / "sweep" / "sigma1-H4-s0" / "metrics.jsonl") == kept
-    other_grids = [(["--seeds", "3"], "seeds"), (["--sigmas", "0.5"], "sigmas"), (["--horizons", "2"], "horizons")]
+    other_grids = [(["--seeds", "3"], "seeds"), (["--sigmas", "0.5"], "sigmas"), (["--horizons", "2"], "horizons"),
+                   (["--vary", "learning_rate=0.01"], "learning_rate")]  # fmt: skip
     for grid, field in other_grids:
         assert sweep.main(["--resume", run_dir, *grid, "--iterations", "4", "--no-plot", "--quiet"]) == 2
         err = capsys.readouterr().err.strip()

@@ -66,8 +66,8 @@ class ES(Chunked):
         )
         self.es_params = self.strategy.default_params
 
-    def hyper(self) -> dict:
-        return {}
+    def hyper(self, cfg: TrainConfig | None = None) -> dict:
+        return {}  # nothing traced: a sweep's members differ only by seed
 
     def init(self, key: jax.Array) -> EsState:
         k_policy, k_search, k_run = jax.random.split(key, 3)

@@ -77,8 +77,8 @@ class HER(Chunked):
         rewards = (float(env.reward_of(g, g)), float(env.reward_of(g, g + 1e3)), 0.0)
         self.target_range = (min(rewards) / (1 - her.gamma), max(rewards) / (1 - her.gamma))
 
-    def hyper(self) -> dict:
-        return {}
+    def hyper(self, cfg: TrainConfig | None = None) -> dict:
+        return {}  # nothing traced: a sweep's members differ only by seed
 
     def init(self, key: jax.Array) -> HerState:
         env = self.env

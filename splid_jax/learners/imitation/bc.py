@@ -23,13 +23,14 @@ def bc_step(
     batch,
     weight,
     online=None,
-    ema: float = 0.0,
+    acting_step: float | jax.Array = 1.0,
 ):
     """One gradient step; ``weight`` = 0 turns it into a no-op (empty buffer) with static shapes.
 
     ``online`` is None when the cloned parameters act themselves (``pstate.params``). Otherwise they
-    are ``online``, and ``pstate.params`` follows them as a Polyak average with decay ``ema``: each
-    step's minibatch noise on the noisy explored actions then averages out of the acting policy."""
+    are ``online``, and ``pstate.params`` follows them as a Polyak average with step ``acting_step``
+    (1 - its decay): each step's minibatch noise on the noisy explored actions then averages out of
+    the acting policy."""
     cloned = pstate.params if online is None else online
     loss, grads = jax.value_and_grad(bc_loss)(cloned, policy, pstate, *batch)
     grads = jax.tree_util.tree_map(lambda g: g * weight, grads)
@@ -39,7 +40,7 @@ def bc_step(
     new_cloned, new_opt = unless_empty(new_cloned, cloned), unless_empty(new_opt, opt_state)
     if online is None:
         return pstate.replace(params=new_cloned), new_opt, None, loss
-    acting = unless_empty(optax.incremental_update(new_cloned, pstate.params, 1.0 - ema), pstate.params)
+    acting = unless_empty(optax.incremental_update(new_cloned, pstate.params, acting_step), pstate.params)
     return pstate.replace(params=acting), new_opt, new_cloned, loss
 
 
@@ -53,7 +54,7 @@ def bc_epoch(
     num_steps: int,
     batch_size: int,
     online=None,
-    ema: float = 0.0,
+    acting_step: float | jax.Array = 1.0,
 ):
     """``num_steps`` minibatch steps from the buffer; returns (pstate, opt_state, online, mean loss)."""
     weight = (buf.size > 0).astype(jnp.float32)
@@ -61,7 +62,7 @@ def bc_epoch(
     def one(carry, k):
         ps, os, on = carry
         batch = relabel_buffer.sample(buf, k, batch_size)
-        ps, os, on, loss = bc_step(policy, optimiser, ps, os, batch, weight, on, ema)
+        ps, os, on, loss = bc_step(policy, optimiser, ps, os, batch, weight, on, acting_step)
         return (ps, os, on), loss
 
     (pstate, opt_state, online), losses = jax.lax.scan(

@@ -37,10 +37,14 @@ class TrainState:
 
 @struct.dataclass
 class Hyper:
-    """Hyper-parameters that may differ between members of one vmapped sweep."""
+    """Hyper-parameters that may differ between members of one vmapped sweep (the registry's ``sweeps``).
+    The state holds an online copy of the parameters only when the sweep's own policy_ema is > 0."""
 
     sigma: jax.Array  # [] float32
     horizon: jax.Array  # [] int32, <= the trainer's max_horizon
+    sigma_end: jax.Array  # [] float32
+    learning_rate: jax.Array  # [] float32
+    acting_step: jax.Array  # [] float32: 1 - policy_ema, taken in double as a constant's would be
 
 
 class Trainer(Chunked):
@@ -71,17 +75,20 @@ class Trainer(Chunked):
             achieved_start=env.achieved_goal_start if bc.relative_goal else None,
             goal_unit=env.success_distance,
         )
-        self.optimiser = optax.adam(bc.learning_rate)
         if mesh is not None:
             check(cfg.num_envs % mesh.size == 0, "num_envs", cfg.num_envs, f"a multiple of the {mesh.size} devices")
             # a model first built inside shard_map's trace would carry its manual axis into evaluation
             getattr(env, "mjx_model", None)
         self.mesh = mesh
 
-    def hyper(self, sigma: float | None = None, horizon: int | None = None) -> Hyper:
+    def hyper(self, cfg: TrainConfig | None = None) -> Hyper:
+        bc = self.bc if cfg is None else cfg.learner_config()
         return Hyper(
-            sigma=jnp.float32(self.bc.sigma if sigma is None else sigma),
-            horizon=jnp.int32(self.bc.horizon if horizon is None else horizon),
+            sigma=jnp.float32(bc.sigma),
+            horizon=jnp.int32(bc.horizon),
+            sigma_end=jnp.float32(bc.sigma_end),
+            learning_rate=jnp.float32(bc.learning_rate),
+            acting_step=jnp.float32(1.0 - bc.policy_ema),
         )
 
     def init(self, key: jax.Array) -> TrainState:
@@ -90,7 +97,7 @@ class Trainer(Chunked):
         env, bc = self.env, self.bc
         return TrainState(
             policy=pstate,
-            opt_state=self.optimiser.init(pstate.params),
+            opt_state=optax.adam(bc.learning_rate).init(pstate.params),  # Adam's state is the same at any rate
             online=None if bc.policy_ema == 0 else jax.tree_util.tree_map(jnp.copy, pstate.params),
             buffer=relabel_buffer.init(bc.buffer_size, env.obs_size, env.goal_size, env.action_size),
             key=k_run,
@@ -119,18 +126,7 @@ class Trainer(Chunked):
             cands = gcsl.relabel(env, seen, bc.gcsl_relabel, k_relabel)
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
         pstate = policy.update_normaliser(ts.policy, seen.obs, seen.achieved[:-1], ~seen.invalid[:-1])
-        pstate, opt_state, online, loss = bc_epoch(
-            policy,
-            self.optimiser,
-            pstate,
-            ts.opt_state,
-            buf,
-            k_bc,
-            bc.bc_steps,
-            bc.batch_size,
-            online=ts.online,
-            ema=bc.policy_ema,
-        )
+        pstate, opt_state, online, loss = self.clone(pstate, ts.opt_state, ts.online, buf, k_bc, hyper)
         metrics = {
             "select_pairs": jnp.sum(cands.valid, dtype=jnp.int32),
             "select_held": jnp.sum(cands.valid & cands.held, dtype=jnp.int32),
@@ -173,6 +169,15 @@ class Trainer(Chunked):
             return traj.seen(), None
         return traj.seen(), self.select(pstate, traj, horizon)
 
+    def clone(self, pstate, opt_state, online, buf: relabel_buffer.Buffer, key, hyper: Hyper):
+        """Behaviour cloning on the buffer, at ``hyper``'s rate and acting average: the one place the
+        settings become BC's arguments. Returns (pstate, opt_state, online, mean loss)."""
+        bc = self.bc
+        optimiser = optax.adam(hyper.learning_rate)
+        return bc_epoch(
+            self.policy, optimiser, pstate, opt_state, buf, key, bc.bc_steps, bc.batch_size, online, hyper.acting_step
+        )
+
     def select(self, pstate, traj: Trajectory, horizon: jax.Array) -> Candidates:
         """SELECT over one exploration's relabelled candidates, as this run's settings ask for."""
         bc = self.bc
@@ -194,7 +199,7 @@ class Trainer(Chunked):
     def sigma_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
         """This iteration's exploration noise: sigma, falling linearly to sigma_end x sigma over the
         first sigma_anneal iterations."""
-        fraction = optax.linear_schedule(1.0, self.bc.sigma_end, max(1, self.bc.sigma_anneal - 1))
+        fraction = optax.linear_schedule(1.0, hyper.sigma_end, max(1, self.bc.sigma_anneal - 1))
         return hyper.sigma * fraction(iteration)
 
     def horizon_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:

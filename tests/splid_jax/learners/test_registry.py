@@ -3,6 +3,7 @@ and what a learner does not read is refused, whatever the name."""
 
 import dataclasses
 
+import jax
 import pytest
 
 import envs
@@ -28,9 +29,13 @@ def test_every_name_builds_its_own_learner_from_its_own_settings():
         assert type(cfg.learner_config()) is settings
         algo = registry.make_algorithm(cfg, env)
         assert type(algo) is learner and algo.name == name
-        hyper = algo.hyper()  # what a sweep's members may hold apart: the learner's traced settings
-        traced = [f.name for f in dataclasses.fields(hyper)] if dataclasses.is_dataclass(hyper) else list(hyper)
-        assert tuple(traced) == registry.get(name).sweeps, name
+        # what a sweep's members may hold apart: each such setting changes the learner's traced values
+        hyper = algo.hyper()
+        assert (hyper == {}) == (registry.get(name).sweeps == ()), name
+        for field in registry.get(name).sweeps:
+            value = getattr(cfg, field)
+            other = dataclasses.replace(cfg, **{field: value - 1 if isinstance(value, int) else value / 2 + 0.1})
+            assert not all(jax.tree.leaves(jax.tree.map(lambda a, b: a == b, algo.hyper(other), hyper))), field
 
 
 def test_a_learner_reads_its_settings_and_the_runs_and_ignores_the_others():
@@ -46,10 +51,11 @@ def test_a_learner_reads_its_settings_and_the_runs_and_ignores_the_others():
     assert not registry.reads("es", "num_envs") and registry.reads("her", "num_envs")
 
 
-def test_only_the_cloning_learners_split_a_run_and_sweep_sigma_and_h():
+def test_only_the_cloning_learners_split_a_run_and_sweep_their_settings():
     splits = {name for name, x in registry.LEARNERS.items() if x.splits_envs}
     assert splits == {"splid", "gcsl", "pchid"}
-    assert all(registry.get(n).sweeps == ("sigma", "horizon") for n in splits)
+    traced = ("sigma", "horizon", "sigma_end", "learning_rate", "policy_ema")
+    assert all(registry.get(n).sweeps == (traced if n in splits else ()) for n in registry.names())
     assert [n for n, x in registry.LEARNERS.items() if x.grows_horizon] == ["pchid"]
     assert [n for n, x in registry.LEARNERS.items() if x.clones_every_pair] == ["gcsl"]
 

@@ -38,8 +38,8 @@ class Toy:
         # "scale" is weakly typed, as leaves of a real init can be: a restored one must compile the same
         return {"w": jnp.zeros(3), "scale": jnp.asarray(1.0), "key": key, "iteration": jnp.int32(0)}
 
-    def hyper(self):
-        return {"sigma": jnp.float32(self.cfg.sigma)}
+    def hyper(self, cfg=None):
+        return {"sigma": jnp.float32((cfg or self.cfg).sigma)}
 
     def chunk(self, state, hyper):
         def one(s, _):

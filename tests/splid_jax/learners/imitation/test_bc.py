@@ -29,12 +29,12 @@ def test_bc_steps_on_a_fixed_batch_lower_the_loss():
     assert float(after) < 0.2 * float(before)
 
 
-def test_polyak_acting_policy_follows_the_cloned_one_at_rate_one_minus_decay():
+def test_polyak_acting_policy_follows_the_cloned_one_at_its_step_one_minus_decay():
     policy, pstate, batch = _setup()
     opt = optax.adam(1e-2)
     opt_state = opt.init(pstate.params)
     online = jax.tree_util.tree_map(jnp.copy, pstate.params)
-    step = jax.jit(lambda p, o, on: bc_step(policy, opt, p, o, batch, 1.0, on, 0.9))
+    step = jax.jit(lambda p, o, on: bc_step(policy, opt, p, o, batch, 1.0, on, acting_step=0.1))  # decay 0.9
     acting, _, cloned, _ = step(pstate, opt_state, online)
     # one step: the acting parameters move a tenth of the way the cloned ones moved
     moved = jax.tree_util.tree_map(lambda a, c, o: a - (o + 0.1 * (c - o)), acting.params, cloned, online)
