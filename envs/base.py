@@ -35,6 +35,8 @@ class State:
 class GoalEnv(abc.ABC):
     """Base for tasks. Subclasses are frozen dataclasses whose fields are the task's options."""
 
+    moves_fingers = False  # whether the last action opens and closes fingers (a learner may explore it apart)
+
     def settings(self) -> dict:
         """Every option of this task, defaults included, by name: what a checkpoint records so that a
         resume under changed task defaults is caught, not silently continued. An option that changes

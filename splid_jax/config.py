@@ -73,15 +73,24 @@ class TrainConfig:
         None, "iterations over which sigma anneals to sigma_end x sigma, which it keeps from then on"
     )
     horizon: int = field(8, "learning horizon H: hindsight goals come from 1..H steps ahead")
+    gripper_hold: int = field(
+        1,
+        "pick_and_place: steps for which the exploration noise on the fingers' open/close command is held "
+        "before it is drawn again (1: afresh every step, as the arm's), so a grasp met by chance lasts long "
+        "enough for the arm's noise to lift the object",
+        recorded_when_set=True,
+    )
     hold_horizon: int = field(
         0,
         "hold, settle, stop: steps over which a held-goal candidate is judged (its goal is the object's place "
         "that many steps on); 0: H. Below H it shortens those replays, which dominate SELECT's work at a long H",
+        recorded_when_set=True,
     )
     rest_horizon: int = field(
         0,
         "rest: 0 looks for resting places within H; above H, Algorithm 2's goals keep H and resting places "
         "are looked for up to rest_horizon steps ahead (below the episode length)",
+        recorded_when_set=True,
     )
     algo: str = field("splid", "learner: " + ", ".join(f"{x.name} ({x.summary})" for x in registry.LEARNERS.values()))
     select: bool = field(True, "SELECT by first hit time; --no-select stores every relabelled pair (ablation)")
@@ -213,6 +222,10 @@ class TrainConfig:
         for name, lowest in (("horizon", 1), ("rest_horizon", 0)):
             value = getattr(self, name)
             check(value <= last, name, value, f"an integer in [{lowest}, {last}] (below the episode length)")
+        fingers = env.moves_fingers
+        allowed = f"an integer in [1, {env.episode_length}]" if fingers else "1 on this task, whose fingers are locked"
+        ok = self.gripper_hold <= (env.episode_length if fingers else 1)
+        check(ok, "gripper_hold", self.gripper_hold, allowed)
 
     def to_json(self) -> dict[str, Any]:
         return dataclasses.asdict(self)

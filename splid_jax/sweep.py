@@ -54,7 +54,7 @@ class Member:
     seed: int
     sigma: float
     horizon: int
-    settings: tuple[tuple[str, float], ...] = ()  # the --vary fields' values, in the order given
+    settings: tuple[tuple[str, float | int], ...] = ()  # the --vary fields' values, in the order given
 
     @property
     def name(self) -> str:
@@ -67,7 +67,7 @@ def members(
     sigmas: tuple[float, ...],
     horizons: tuple[int, ...],
     base_seed: int = 0,
-    varied: dict[str, tuple[float, ...]] | None = None,
+    varied: dict[str, tuple[float | int, ...]] | None = None,
 ) -> list[Member]:
     """Every combination of sigma, H and the ``varied`` fields' values, each on ``seeds`` seeds."""
     varied = varied or {}
@@ -171,12 +171,15 @@ def build_parser() -> Parser:
     return parser
 
 
+TYPES = {f.name: str(f.type) for f in dataclasses.fields(TrainConfig)}
+
+
 def _sweepable(algo: str) -> tuple[str, ...]:
     """The traced settings ``--vary`` takes for ``algo``: its sweeps but sigma and H (their own flags)."""
     return tuple(f for f in registry.get(algo).sweeps if f not in ("sigma", "horizon"))
 
 
-def varied_values(items: list[str] | None, algo: str) -> dict[str, tuple[float, ...]]:
+def varied_values(items: list[str] | None, algo: str) -> dict[str, tuple[float | int, ...]]:
     """``--vary FIELD=V1,V2`` items as ``{field: values}``, each field one of ``algo``'s traced settings."""
     out: dict[str, tuple[float, ...]] = {}
     allowed = _sweepable(algo)
@@ -185,7 +188,8 @@ def varied_values(items: list[str] | None, algo: str) -> dict[str, tuple[float, 
         if not sep or field not in allowed or field in out:
             fields = ", ".join(allowed) or f"none: --algo {algo} traces no setting but sigma and H"
             raise InvalidConfig("vary", item, f"FIELD=V1,V2 with FIELD one of {fields}, each field once")
-        out[field] = _values(field, text, float)
+        kind = int if TYPES[field] == "int" else float
+        out[field] = _values(field, text, kind)
         check(all(map(math.isfinite, out[field])), field, text, "finite numbers")
     return out
 
@@ -214,7 +218,7 @@ def check_same_grid(
     seeds: int | None,
     sigmas: str | None,
     horizons: str | None,
-    varied: dict[str, tuple[float, ...]] | None = None,
+    varied: dict[str, tuple[float | int, ...]] | None = None,
 ) -> None:
     """A resumed sweep trains the grid it started with: a grid flag given anew must name that grid."""
     first = {"seeds": len({m.seed for m in lanes}), "sigmas": tuple(dict.fromkeys(m.sigma for m in lanes)),

@@ -128,6 +128,10 @@ class _FetchTask(GoalEnv):
     target_in_the_air = False
     target_offset = (0.0, 0.0, 0.0)
 
+    @property
+    def moves_fingers(self) -> bool:
+        return not self.block_gripper
+
     def __post_init__(self):
         n = self.kind
         check(self.distance_threshold > 0, f"{n}.distance_threshold", self.distance_threshold, "> 0")

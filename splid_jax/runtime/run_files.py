@@ -4,6 +4,7 @@ the checks that keep one run from overwriting another."""
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import os
 import sys
@@ -36,8 +37,13 @@ def note_task_changes(run_dir: str, saved: dict, env: envs.GoalEnv) -> None:
 
 
 def identity(cfg: TrainConfig) -> dict:
-    """The settings a checkpoint must share with the run resuming it, as JSON stores them."""
-    return json.loads(json.dumps({k: v for k, v in cfg.to_json().items() if k not in MAY_CHANGE_ON_RESUME}))
+    """The settings a checkpoint must share with the run resuming it, as JSON stores them. A setting
+    added after runs were recorded (field metadata ``recorded_when_set``) is left out at its default,
+    which is how those runs behaved, so they still resume."""
+    later = {f.name: f.default for f in dataclasses.fields(cfg) if f.metadata.get("recorded_when_set")}
+    at_default = {k for k, v in cfg.to_json().items() if k in later and v == later[k]}
+    kept = {k: v for k, v in cfg.to_json().items() if k not in MAY_CHANGE_ON_RESUME | at_default}
+    return json.loads(json.dumps(kept))
 
 
 def read_metrics(path: str) -> list[dict]:

@@ -68,3 +68,26 @@ def test_select_horizons_outside_their_range_name_the_field(fields):
 def test_rest_horizon_within_the_episode_is_accepted():
     cfg = TrainConfig(env="point", relabel="rest", horizon=4, rest_horizon=16, hold_horizon=2)
     assert (cfg.rest_horizon, cfg.hold_horizon) == (16, 2)
+
+
+def test_gripper_hold_is_checked_against_the_task():
+    import envs
+
+    with pytest.raises(InvalidConfig, match="gripper_hold"):
+        TrainConfig(env="pick_and_place", gripper_hold=0)
+    for name in ("push", "point"):  # fingers locked, or none: their noise cannot be held
+        with pytest.raises(InvalidConfig, match="invalid gripper_hold=5: must be 1 on this task"):
+            TrainConfig(env=name, gripper_hold=5).check_env(envs.make(name))
+    carry = envs.make("pick_and_place")
+    TrainConfig(env="pick_and_place", gripper_hold=carry.episode_length).check_env(carry)
+    with pytest.raises(InvalidConfig, match="gripper_hold"):
+        TrainConfig(env="pick_and_place", gripper_hold=carry.episode_length + 1).check_env(carry)
+
+
+def test_a_checkpoint_records_a_later_setting_only_when_it_is_set():
+    from splid_jax.runtime.run_files import identity
+
+    later = ("hold_horizon", "rest_horizon", "gripper_hold")
+    assert not set(later) & set(identity(TrainConfig(env="pick_and_place")))  # as runs recorded before them
+    changed = identity(TrainConfig(env="pick_and_place", hold_horizon=4, gripper_hold=5))
+    assert (changed["hold_horizon"], changed["gripper_hold"]) == (4, 5) and "rest_horizon" not in changed

@@ -58,6 +58,8 @@ def test_vary_grids_over_traced_settings_in_one_program(tmp_path):
         ("learning_rate=inf", "learning_rate"),
         ("policy_ema=0.5,0.5", "policy_ema"),
         ("sigma_end=0.5,2", "sigma_end"),
+        ("gripper_hold=1,5", "gripper_hold"),  # point has no fingers to hold
+        ("gripper_hold=1.5", "gripper_hold"),
     ],
 )
 def test_vary_names_the_field_of_a_bad_value(capsys, tmp_path, vary, field):

@@ -45,6 +45,13 @@ def draws(env: GoalEnv, key: jax.Array, num_envs: int) -> tuple[jax.Array, jax.A
     return jax.random.split(k_reset, num_envs), noise
 
 
+def hold_fingers(noise: jax.Array, hold: jax.Array) -> jax.Array:
+    """``noise`` ([T, N, A]) with its last action's (the fingers') draws held for ``hold`` steps: the
+    value drawn at each multiple of ``hold`` repeats until the next, while the arm's stay fresh."""
+    t = jnp.arange(noise.shape[0])
+    return noise.at[:, :, -1].set(noise[(t // hold) * hold, :, -1])
+
+
 def rollout(
     env: GoalEnv, policy: Policy, pstate: PolicyState, reset_keys: jax.Array, noise: jax.Array, sigma: jax.Array
 ) -> Trajectory:

@@ -20,7 +20,7 @@ from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.bc import bc_epoch
 from splid_jax.learners.imitation.candidates import Candidates
 from splid_jax.learners.imitation.config import ImitationConfig, select_modes
-from splid_jax.learners.imitation.explore import Seen, Trajectory, draws, rollout
+from splid_jax.learners.imitation.explore import Seen, Trajectory, draws, hold_fingers, rollout
 from splid_jax.learners.splid.select import select
 from splid_jax.runtime.devices import ENVS
 
@@ -45,6 +45,7 @@ class Hyper:
     sigma_end: jax.Array  # [] float32
     learning_rate: jax.Array  # [] float32
     acting_step: jax.Array  # [] float32: 1 - policy_ema, taken in double as a constant's would be
+    gripper_hold: jax.Array  # [] int32, steps the fingers' noise is held (tasks that move them)
 
 
 class Trainer(Chunked):
@@ -89,6 +90,7 @@ class Trainer(Chunked):
             sigma_end=jnp.float32(bc.sigma_end),
             learning_rate=jnp.float32(bc.learning_rate),
             acting_step=jnp.float32(1.0 - bc.policy_ema),
+            gripper_hold=jnp.int32(bc.gripper_hold),
         )
 
     def init(self, key: jax.Array) -> TrainState:
@@ -119,6 +121,8 @@ class Trainer(Chunked):
         env, cfg, bc, policy = self.env, self.cfg, self.bc, self.policy
         key, k_explore, k_bc, k_relabel = jax.random.split(ts.key, 4)
         reset_keys, noise = draws(env, k_explore, cfg.num_envs)
+        if env.moves_fingers:
+            noise = hold_fingers(noise, hyper.gripper_hold)
         horizon = self.horizon_at(ts.iteration, hyper)
         sigma = self.sigma_at(ts.iteration, hyper)
         seen, cands = self.explore_and_select(ts.policy, reset_keys, noise, sigma, horizon)
