@@ -181,7 +181,7 @@ def _sweepable(algo: str) -> tuple[str, ...]:
 
 def varied_values(items: list[str] | None, algo: str) -> dict[str, tuple[float | int, ...]]:
     """``--vary FIELD=V1,V2`` items as ``{field: values}``, each field one of ``algo``'s traced settings."""
-    out: dict[str, tuple[float, ...]] = {}
+    out: dict[str, tuple[float | int, ...]] = {}
     allowed = _sweepable(algo)
     for item in items or ():
         field, sep, text = (x.strip() for x in item.partition("="))
