@@ -24,15 +24,7 @@ pytest_plugins = ("tests.hang_watchdog",)  # a test that hangs ends its worker, 
 # since an unknown XLA flag aborts the process.
 # LLVM's optimisation level 0 compiles a Fetch episode program in 3.5 s instead of 5.6 s and runs it
 # 3x slower, a trade the suite's tiny programs win.
-# XLA:CPU's concurrency-optimised thunk scheduler and multi-threaded Eigen, off: with them, about one run
-# in 25 of a small vmapped sweep never finished (all XLA threads idle, the caller waiting; NOTES, "A
-# computation that never finishes on the CPU"); without them 118 repeats finished.
-CPU_COMPILE_FLAGS = (
-    "--xla_cpu_use_fusion_emitters=false",
-    "--xla_backend_optimization_level=0",
-    "--xla_cpu_enable_concurrency_optimized_scheduler=false",
-    "--xla_cpu_multi_thread_eigen=false",
-)
+CPU_COMPILE_FLAGS = ("--xla_cpu_use_fusion_emitters=false", "--xla_backend_optimization_level=0")
 
 
 def _faster_cpu_compiles() -> None:
