@@ -2,9 +2,9 @@
 thread's stack and the test's id go to the hang log, and its process exits, so the run goes on
 instead of waiting forever.
 
-Why: XLA:CPU (jaxlib 0.10) has been seen, rarely, to park every thread in a computation that never
-returns while more JAX processes than cores share the machine (the suite's two workers and a test's
-subprocess). A Python-level timeout cannot end such a call, and pytest-timeout's own dump is lost
+Why: XLA:CPU (jaxlib 0.10) now and then never finishes a computation: the caller waits while every XLA
+thread is idle (about one run in 25 of a small vmapped sweep; experiments/NOTES.md, "A computation that
+never finishes on the CPU"). A Python-level timeout cannot end such a call, and pytest-timeout's own dump is lost
 with an xdist worker's stderr; the log keeps it. ``.ci/run`` runs a test that hung once more, and
 only when hangs were the run's only failures.
 

@@ -41,8 +41,11 @@ def identity(cfg: TrainConfig) -> dict:
     added after runs were recorded (field metadata ``recorded_when_set``) is left out at its default,
     which is how those runs behaved, so they still resume."""
     later = {f.name: f.default for f in dataclasses.fields(cfg) if f.metadata.get("recorded_when_set")}
-    at_default = {k for k, v in cfg.to_json().items() if k in later and v == later[k]}
-    kept = {k: v for k, v in cfg.to_json().items() if k not in MAY_CHANGE_ON_RESUME | at_default}
+    kept = {
+        k: v
+        for k, v in cfg.to_json().items()
+        if k not in MAY_CHANGE_ON_RESUME and not (k in later and v == later[k])
+    }
     return json.loads(json.dumps(kept))
 
 
