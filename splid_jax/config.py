@@ -73,6 +73,13 @@ class TrainConfig:
         None, "iterations over which sigma anneals to sigma_end x sigma, which it keeps from then on"
     )
     horizon: int = field(8, "learning horizon H: hindsight goals come from 1..H steps ahead")
+    horizon_end: int = field(
+        0,
+        "splid: the learning horizon at the end of the noise's annealing: H falls linearly to horizon_end over "
+        "the first sigma_anneal iterations, so long horizons speed early learning and short ones judge the "
+        "final approach (0: H throughout)",
+        recorded_when_set=True,
+    )
     gripper_hold: int = field(
         1,
         "pick_and_place: steps for which the exploration noise on the fingers' open/close command is held "

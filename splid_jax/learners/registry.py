@@ -36,13 +36,15 @@ class Learner:
 
 IMITATION_FIELDS = tuple(f.name for f in dataclasses.fields(ImitationConfig))
 # SELECT's settings, read by SPLID and PCHID; GCSL clones every relabelled pair and selects nothing
-SELECT_FIELDS = ("horizon", "hold_horizon", "rest_horizon", "select", "relabel", "select_radius", "select_lanes")
+SELECT_FIELDS = (
+    "horizon", "horizon_end", "hold_horizon", "rest_horizon", "select", "relabel", "select_radius", "select_lanes"
+)
 _CLONING = tuple(f for f in IMITATION_FIELDS if f not in (*SELECT_FIELDS, "gcsl_relabel", "pchid_every"))
 _TRAINER = "splid_jax.learners.splid.trainer:Trainer"
 _IMITATION = dict(
     settings=ImitationConfig,
     splits_envs=True,
-    sweeps=("sigma", "horizon", "sigma_end", "learning_rate", "policy_ema", "gripper_hold"),
+    sweeps=("sigma", "horizon", "horizon_end", "sigma_end", "learning_rate", "policy_ema", "gripper_hold"),
 )
 # HER on the Fetch tasks runs as OpenAI Baselines: a cycle explores 2 episodes on each of 8 workers
 # (num_envs 16, with HerConfig's batch of 2048 = 8 x 256 averaged gradients) and an epoch of 50 cycles

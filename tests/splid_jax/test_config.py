@@ -55,12 +55,14 @@ def test_sigma_schedule_outside_its_range_names_the_field(field, value):
     [
         {"hold_horizon": -1},
         {"hold_horizon": 9},  # above the horizon 8
+        {"horizon_end": -1},
+        {"horizon_end": 9},  # above the horizon 8
         {"rest_horizon": 16},  # without relabel=rest
         {"rest_horizon": 8, "relabel": "rest"},  # not above the horizon
     ],
 )
 def test_select_horizons_outside_their_range_name_the_field(fields):
-    name = next(k for k in fields if k.endswith("horizon"))
+    name = next(k for k in fields if "horizon" in k)
     with pytest.raises(InvalidConfig, match=name):
         TrainConfig(env="point", **fields)
 
@@ -87,7 +89,8 @@ def test_gripper_hold_is_checked_against_the_task():
 def test_a_checkpoint_records_a_later_setting_only_when_it_is_set():
     from splid_jax.runtime.run_files import identity
 
-    later = ("hold_horizon", "rest_horizon", "gripper_hold")
+    later = ("hold_horizon", "rest_horizon", "gripper_hold", "horizon_end")
     assert not set(later) & set(identity(TrainConfig(env="pick_and_place")))  # as runs recorded before them
-    changed = identity(TrainConfig(env="pick_and_place", hold_horizon=4, gripper_hold=5))
-    assert (changed["hold_horizon"], changed["gripper_hold"]) == (4, 5) and "rest_horizon" not in changed
+    changed = identity(TrainConfig(env="pick_and_place", hold_horizon=4, gripper_hold=5, horizon_end=6))
+    assert (changed["hold_horizon"], changed["gripper_hold"], changed["horizon_end"]) == (4, 5, 6)
+    assert "rest_horizon" not in changed

@@ -47,6 +47,16 @@ def test_vary_grids_over_traced_settings_in_one_program(tmp_path):
     assert len(set(losses.values())) == 4  # each member trains with its own rate and average
 
 
+def test_vary_horizon_end_lets_each_member_anneal_its_own_horizon(tmp_path):
+    args = ["--env", "point", "--num-envs", "4", "--eval-episodes", "8", "--iterations", "4", "--eval-every", "2",
+            "--bc-steps", "5", "--batch-size", "16", "--hidden", "16", "--seeds", "1", "--horizons", "6",
+            "--sigma-anneal", "4", "--no-plot", "--quiet", "--run-dir", str(tmp_path)]  # fmt: skip
+    assert sweep.main([*args, "--vary", "horizon_end=0,2"]) == 0
+    horizons = {n: [r["horizon"] for r in read(tmp_path / f"sigma1-H6-horizon_end{n}-s0" / "metrics.jsonl")]
+                for n in (0, 2)}  # fmt: skip
+    assert horizons == {0: [6, 6], 2: [5, 2]}  # iterations 2 and 4 of a fall from 6 to 2 over 4
+
+
 @pytest.mark.parametrize(
     "vary, field",
     [
@@ -60,6 +70,7 @@ def test_vary_grids_over_traced_settings_in_one_program(tmp_path):
         ("sigma_end=0.5,2", "sigma_end"),
         ("gripper_hold=1,5", "gripper_hold"),  # point has no fingers to hold
         ("gripper_hold=1.5", "gripper_hold"),
+        ("horizon_end=2,99", "horizon_end"),  # above the horizon
     ],
 )
 def test_vary_names_the_field_of_a_bad_value(capsys, tmp_path, vary, field):

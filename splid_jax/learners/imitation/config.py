@@ -26,6 +26,7 @@ class ImitationConfig:
     sigma_end: float
     sigma_anneal: int
     horizon: int
+    horizon_end: int
     gripper_hold: int
     hold_horizon: int
     rest_horizon: int
@@ -53,6 +54,12 @@ class ImitationConfig:
         check(0 <= self.sigma_end <= 1, "sigma_end", self.sigma_end, "in [0, 1] (a fraction of sigma)")
         check(self.sigma_anneal >= 1, "sigma_anneal", self.sigma_anneal, "an integer >= 1")
         check(self.horizon >= 1, "horizon", self.horizon, "an integer >= 1 (and < the episode length)")
+        check(
+            0 <= self.horizon_end <= self.horizon,
+            "horizon_end",
+            self.horizon_end,
+            f"an integer in [0, {self.horizon}] (0: H throughout; at most H)",
+        )
         check(self.gripper_hold >= 1, "gripper_hold", self.gripper_hold, "an integer >= 1 (1: noise drawn every step)")
         check(
             0 <= self.hold_horizon <= self.horizon,

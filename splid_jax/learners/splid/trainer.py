@@ -42,6 +42,7 @@ class Hyper:
 
     sigma: jax.Array  # [] float32
     horizon: jax.Array  # [] int32, <= the trainer's max_horizon
+    horizon_end: jax.Array  # [] int32, the horizon the annealing ends at (0: H throughout)
     sigma_end: jax.Array  # [] float32
     learning_rate: jax.Array  # [] float32
     acting_step: jax.Array  # [] float32: 1 - policy_ema, taken in double as a constant's would be
@@ -67,6 +68,8 @@ class Trainer(Chunked):
         # shapes; a sweep's members mask larger h through Hyper.horizon
         self.max_horizon = max(bc.horizon, bc.rest_horizon)
         self.pchid_every = max(1, bc.pchid_every)  # TrainConfig resolves 0 for pchid
+        allowed = "0 for pchid, whose horizon grows over the run"
+        check(not (self.learner.grows_horizon and bc.horizon_end), "horizon_end", bc.horizon_end, allowed)
         self.policy = make_policy(
             env.obs_size,
             env.goal_size,
@@ -87,6 +90,7 @@ class Trainer(Chunked):
         return Hyper(
             sigma=jnp.float32(bc.sigma),
             horizon=jnp.int32(bc.horizon),
+            horizon_end=jnp.int32(bc.horizon_end),
             sigma_end=jnp.float32(bc.sigma_end),
             learning_rate=jnp.float32(bc.learning_rate),
             acting_step=jnp.float32(1.0 - bc.policy_ema),
@@ -207,9 +211,13 @@ class Trainer(Chunked):
         return hyper.sigma * fraction(iteration)
 
     def horizon_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
-        """The learning horizon of this iteration: H, or PCHID's curriculum 1, 2, ..., H."""
+        """The learning horizon of this iteration: H (falling to horizon_end with the noise's annealing), or
+        PCHID's curriculum 1, 2, ..., H."""
         if not self.learner.grows_horizon:
-            return hyper.horizon
+            left = optax.linear_schedule(1.0, 0.0, max(1, self.bc.sigma_anneal - 1))(iteration)
+            end = hyper.horizon_end
+            falling = jnp.round(end + (hyper.horizon - end) * left).astype(jnp.int32)
+            return jnp.where(end > 0, falling, hyper.horizon)
         return jnp.minimum(hyper.horizon, 1 + iteration // self.pchid_every).astype(jnp.int32)
 
     def chunk_metrics(self, ts: TrainState, hyper: Hyper, per_iter: dict) -> dict:

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import envs
+from splid_jax.common.errors import InvalidConfig
 from splid_jax.common.evaluation import evaluate
 from splid_jax.common.networks import make_policy
 from splid_jax.config import TrainConfig
@@ -62,6 +63,17 @@ def test_pchid_horizon_grows_by_one_every_pchid_every_iterations_up_to_h():
     for algo in ("splid", "gcsl"):  # the full horizon from the start
         fixed = Trainer(env, TrainConfig(**small, algo=algo))
         assert [int(fixed.horizon_at(jnp.int32(i), fixed.hyper())) for i in (0, 7, 39)] == [4, 4, 4]
+
+
+def test_splid_horizon_falls_to_horizon_end_with_the_noise_and_pchid_refuses_it():
+    env = envs.make("point")
+    small = dict(env="point", iterations=40, horizon=12, hidden=(8,), sigma_end=0.5, sigma_anneal=5)
+    falling = Trainer(env, TrainConfig(**small, horizon_end=8))
+    assert [int(falling.horizon_at(jnp.int32(i), falling.hyper())) for i in range(7)] == [12, 11, 10, 9, 8, 8, 8]
+    sigmas = [float(falling.sigma_at(jnp.int32(i), falling.hyper())) for i in (0, 4)]
+    assert sigmas == pytest.approx([1.0, 0.5])  # the horizon's schedule is the noise's
+    with pytest.raises(InvalidConfig, match="horizon_end"):
+        Trainer(env, TrainConfig(**small, algo="pchid", horizon_end=8))
 
 
 def test_gcsl_and_pchid_learn_on_the_point_task():
