@@ -175,8 +175,9 @@ TYPES = {f.name: str(f.type) for f in dataclasses.fields(TrainConfig)}
 
 
 def _sweepable(algo: str) -> tuple[str, ...]:
-    """The traced settings ``--vary`` takes for ``algo``: its sweeps but sigma and H (their own flags)."""
-    return tuple(f for f in registry.get(algo).sweeps if f not in ("sigma", "horizon"))
+    """The traced settings ``--vary`` takes for ``algo``: those of its sweeps it reads, but sigma and H (their
+    own flags)."""
+    return tuple(f for f in registry.get(algo).sweeps if f not in ("sigma", "horizon") and registry.reads(algo, f))
 
 
 def varied_values(items: list[str] | None, algo: str) -> dict[str, tuple[float | int, ...]]:

@@ -68,7 +68,7 @@ LEARNERS: dict[str, Learner] = {
             "pchid",
             "SPLID with the horizon grown 1..H, see --pchid-every",
             _TRAINER,
-            reads=(*_CLONING, *SELECT_FIELDS, "pchid_every"),
+            reads=(*_CLONING, *(f for f in SELECT_FIELDS if f != "horizon_end"), "pchid_every"),  # its own curriculum
             **_IMITATION,
             grows_horizon=True,
         ),

@@ -82,7 +82,8 @@ def test_vary_names_the_field_of_a_bad_value(capsys, tmp_path, vary, field):
 
 def test_vary_refuses_a_field_given_twice_or_one_the_learner_does_not_trace(capsys, tmp_path):
     for args, field in [(["--learning-rate", "0.001", "--vary", "learning_rate=0.001,0.01"], "learning_rate"),
-                        (["--algo", "her", "--vary", "learning_rate=0.001,0.01"], "vary")]:  # fmt: skip
+                        (["--algo", "her", "--vary", "learning_rate=0.001,0.01"], "vary"),
+                        (["--algo", "pchid", "--vary", "horizon_end=0,2"], "vary")]:  # fmt: skip
         assert sweep.main(["--env", "point", *args, "--run-dir", str(tmp_path / "x")]) == 2
         err = capsys.readouterr().err.strip()
         assert len(err.splitlines()) == 1 and f"invalid {field}=" in err

@@ -45,7 +45,7 @@ def test_a_learner_reads_its_settings_and_the_runs_and_ignores_the_others():
         assert all(registry.reads(name, f) for f in run_fields if f != "num_envs"), name
     assert registry.ignores("splid") == ("gcsl_relabel", "pchid_every")
     assert set(registry.ignores("gcsl")) == {*registry.SELECT_FIELDS, "pchid_every"}
-    assert registry.ignores("pchid") == ("gcsl_relabel",)
+    assert registry.ignores("pchid") == ("horizon_end", "gcsl_relabel")  # its horizon grows instead
     assert set(registry.ignores("her")) == set(registry.IMITATION_FIELDS)
     assert set(registry.ignores("es")) == set(registry.IMITATION_FIELDS) - {"hidden"}
     assert not registry.reads("es", "num_envs") and registry.reads("her", "num_envs")
