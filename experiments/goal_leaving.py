@@ -38,9 +38,7 @@ def analyse(env, states, actions) -> dict:
     speed = np.linalg.norm(obj[1:] - obj[:-1], axis=-1) / dt  # [T, E] over step t
     speed_at_hit = speed[first, e]
     arm = np.linalg.norm(np.asarray(actions)[1:, :, :3], axis=-1)  # the arm's command in the state after step t
-    on_goal_arm = [arm[succ[:, i], i].mean() for i in range(E) if hit[i]]
-    on_goal_stayed = [arm[succ[:, i], i].mean() for i in range(E) if hit[i] and final[i]]
-    on_goal_left = [arm[succ[:, i], i].mean() for i in range(E) if left[i]]
+    on_goal = np.array([arm[succ[:, i], i].mean() if hit[i] else np.nan for i in range(E)])  # per episode
     leave = np.minimum(last_on + 1, T - 1)  # the first step after which the object was off the goal for good
     grip_obj_at_leave = np.linalg.norm(grip[leave + 1, e] - obj[leave + 1, e], axis=-1)
     final_dist = np.linalg.norm(obj[-1] - goal, axis=-1)
@@ -60,8 +58,8 @@ def analyse(env, states, actions) -> dict:
         "first_hit_step_median": median(first[hit]),
         "object_speed_at_first_hit_median": {"stayed": median(speed_at_hit[hit & final]),
                                               "left": median(speed_at_hit[left])},  # fmt: skip
-        "arm_command_on_goal_median": {"all": median(on_goal_arm), "stayed": median(on_goal_stayed),
-                                       "left": median(on_goal_left)},  # fmt: skip
+        "arm_command_on_goal_median": {"all": median(on_goal[hit]), "stayed": median(on_goal[hit & final]),
+                                       "left": median(on_goal[left])},  # fmt: skip
         "left_step_median": median(leave[left]),
         "gripper_object_distance_when_leaving_median": median(grip_obj_at_leave[left]),
         "left_while_gripper_within_4cm": float((grip_obj_at_leave[left] < 0.04).mean()) if left.any() else None,
@@ -69,7 +67,7 @@ def analyse(env, states, actions) -> dict:
         "entries_to_the_goal_median_left": median(entries[left]),
         "final_distance_median": {"left": median(final_dist[left]), "never_hit": median(final_dist[~hit])},
         "start_distance_median": {"hit": median(start_dist[hit]), "never_hit": median(start_dist[~hit])},
-        "never_hit_object_moved_under_2cm": float((moved[~hit] < 0.02).mean()) if (~hit).any() else None,
+        "never_hit_object_moved_under_2cm": float(still[~hit].mean()) if (~hit).any() else None,
         "untouched_gripper_object_distance_median": {"start": median(np.linalg.norm(grip[0] - obj[0], axis=-1)[still]),
                                                      "end": median(np.linalg.norm(grip[-1] - obj[-1], axis=-1)[still]),
                                                      "closest": median(near[still])},  # fmt: skip
