@@ -72,13 +72,14 @@ class TrainConfig:
     sigma_anneal: int = field(
         None, "iterations over which sigma anneals to sigma_end x sigma, which it keeps from then on"
     )
-    horizon: int = field(8, "learning horizon H: hindsight goals come from 1..H steps ahead")
+    horizon: int = field(None, "learning horizon H: hindsight goals come from 1..H steps ahead")
     horizon_end: int = field(
-        0,
+        None,
         "splid: the learning horizon at the end of the noise's annealing: H falls linearly to horizon_end over "
         "the first sigma_anneal iterations, so long horizons speed early learning and short ones judge the "
-        "final approach (0: H throughout)",
+        "final approach (0: H throughout; with --horizon given and this not, 0)",
         recorded_when_set=True,
+        unrecorded=0,
     )
     gripper_hold: int = field(
         1,
@@ -182,6 +183,9 @@ class TrainConfig:
             )
             object.__setattr__(self, "num_envs", per_generation)
         defaults = {**TASK_DEFAULTS[self.env], **learner.task_defaults.get(self.env, {})}
+        if self.horizon_end is None:  # a task's falling horizon goes with its own H, not with one the caller set
+            task_end = defaults["horizon_end"] if self.horizon is None else 0
+            object.__setattr__(self, "horizon_end", task_end if registry.reads(learner.name, "horizon_end") else 0)
         for name, value in defaults.items():  # fill per-algorithm, then per-task defaults for fields left at None
             if getattr(self, name) is None:
                 object.__setattr__(self, name, value)
@@ -245,6 +249,8 @@ class TrainConfig:
 
 _POINT = dict(
     relabel="paper",
+    horizon=8,
+    horizon_end=0,
     iterations=100,
     select_lanes=1.0,
     num_envs=32,
@@ -263,6 +269,8 @@ _POINT = dict(
 )
 _FETCH = dict(
     relabel="paper",
+    horizon=8,
+    horizon_end=0,
     iterations=200,
     select_lanes=1.0,
     num_envs=256,
@@ -290,9 +298,11 @@ TASK_DEFAULTS: dict[str, dict[str, Any]] = {
         "iterations": 80,
         "num_envs": 125,
         "relabel": "stop",
+        "horizon": 12,
+        "horizon_end": 8,
         "normalise": False,
         "relative_goal": True,
-        "sigma_end": 0.5,
+        "sigma_end": 0.2,
         "sigma_anneal": 80,
         "buffer_size": 50_000,
         "policy_ema": 0.98,

@@ -103,6 +103,22 @@ def member_configs(cfg: TrainConfig, grid: list[Member]) -> tuple[TrainConfig, l
     return base, lanes
 
 
+def grid_configs(
+    given: dict,
+    seeds: int,
+    sigmas: tuple[float, ...],
+    horizons: tuple[int, ...] | None,
+    varied: dict[str, tuple[float | int, ...]] | None = None,
+) -> tuple[TrainConfig, list[TrainConfig]]:
+    """The sweep's and its members' configs from the explicit settings ``given``. Without ``horizons``
+    the members take the task's own H and the horizon it falls to; a given H is kept throughout unless
+    ``horizon_end`` is given too, as with ``train --horizon``."""
+    own = {} if horizons else {"horizon": TrainConfig(**given).horizon}
+    grid = members(seeds, sigmas, horizons or (own["horizon"],), base_seed=given.get("seed", 0), varied=varied)
+    given = {**given, "sigma": max(sigmas), **({} if own else {"horizon": max(horizons)})}
+    return member_configs(TrainConfig(**given), grid)
+
+
 def run_sweep(cfg: TrainConfig, grid: list[Member], quiet: bool = False, resume: bool = False) -> list[dict]:
     """Train every member of ``grid`` in lock-step; returns each member's last metrics record."""
     base, lanes = member_configs(cfg, grid)
@@ -148,7 +164,11 @@ def build_parser() -> Parser:
     )
     parser.add_argument("--seeds", type=int, default=None, help="seeds per grid point (default: 4)")
     parser.add_argument("--sigmas", default=None, help="comma-separated sigma values (default: 1.0)")
-    parser.add_argument("--horizons", default=None, help="comma-separated H values (default: 8)")
+    parser.add_argument(
+        "--horizons",
+        default=None,
+        help="comma-separated H values, each kept throughout unless --horizon-end is given (default: the task's H)",
+    )
     parser.add_argument(
         "--vary",
         action="append",
@@ -252,13 +272,12 @@ def main(argv: list[str] | None = None) -> int:
                       f"unset with --algo {algo}, which does not read {field}")  # fmt: skip
             given.setdefault("run_dir", os.path.join("runs", f"sweep-{given.get('env', 'point')}"))
             sigmas = _values("sigmas", "1.0" if ns.sigmas is None else ns.sigmas, float)
-            horizons = _values("horizons", "8" if ns.horizons is None else ns.horizons, int)
+            horizons = None if ns.horizons is None else _values("horizons", ns.horizons, int)
             seeds = 4 if ns.seeds is None else ns.seeds
             varied = varied_values(ns.vary, algo)
             for field in varied.keys() & given.keys():
                 raise InvalidConfig(field, given[field], f"given once: either --{field.replace('_', '-')} or --vary")
-            grid = members(seeds, sigmas, horizons, base_seed=given.get("seed", 0), varied=varied)
-            cfg, lanes = member_configs(TrainConfig(**{**given, "horizon": max(horizons), "sigma": max(sigmas)}), grid)
+            cfg, lanes = grid_configs(given, seeds, sigmas, horizons, varied)
         env = make_env(cfg.env, **cfg.env_overrides())
         cfg.check_env(env)
         with recording(ns.tensorboard, per_member=True) as on_record:

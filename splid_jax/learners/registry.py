@@ -71,6 +71,7 @@ LEARNERS: dict[str, Learner] = {
             reads=(*_CLONING, *(f for f in SELECT_FIELDS if f != "horizon_end"), "pchid_every"),  # its own curriculum
             **_IMITATION,
             grows_horizon=True,
+            task_defaults={"push": {"horizon": 8}},  # SPLID's falling horizon on Push is not PCHID's
         ),
         Learner(
             "her",

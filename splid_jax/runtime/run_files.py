@@ -38,9 +38,11 @@ def note_task_changes(run_dir: str, saved: dict, env: envs.GoalEnv) -> None:
 
 def identity(cfg: TrainConfig) -> dict:
     """The settings a checkpoint must share with the run resuming it, as JSON stores them. A setting
-    added after runs were recorded (field metadata ``recorded_when_set``) is left out at its default,
-    which is how those runs behaved, so they still resume."""
-    later = {f.name: f.default for f in dataclasses.fields(cfg) if f.metadata.get("recorded_when_set")}
+    added after runs were recorded (field metadata ``recorded_when_set``) is left out at its default (or at
+    its ``unrecorded`` value, where the default is resolved per task), which is how those runs behaved, so
+    they still resume."""
+    fields = dataclasses.fields(cfg)
+    later = {f.name: f.metadata.get("unrecorded", f.default) for f in fields if f.metadata.get("recorded_when_set")}
     kept = {
         k: v
         for k, v in cfg.to_json().items()

@@ -94,3 +94,21 @@ def test_a_checkpoint_records_a_later_setting_only_when_it_is_set():
     changed = identity(TrainConfig(env="pick_and_place", hold_horizon=4, gripper_hold=5, horizon_end=6))
     assert (changed["hold_horizon"], changed["gripper_hold"], changed["horizon_end"]) == (4, 5, 6)
     assert "rest_horizon" not in changed
+
+
+def test_push_horizon_falls_from_12_to_8_unless_the_caller_sets_h():
+    from splid_jax.runtime.run_files import identity
+
+    horizons = lambda **kw: (lambda c: (c.horizon, c.horizon_end))(TrainConfig(env="push", **kw))  # noqa: E731
+    assert horizons() == (12, 8) and TrainConfig(env="push").sigma_end == 0.2
+    assert horizons(horizon=8) == horizons(horizon=8, horizon_end=0) == (8, 0)  # a given H is kept throughout
+    assert horizons(horizon=16, horizon_end=4) == (16, 4)
+    assert horizons(horizon_end=10) == (12, 10)
+    assert horizons(algo="pchid") == (8, 0)  # PCHID grows its own horizon to the paper's H
+    assert (lambda c: (c.horizon, c.horizon_end))(TrainConfig(env="slide")) == (8, 0)
+    # a Push run recorded before the falling horizon (H = 8, no horizon_end) resumes as it ran
+    before = {k: v for k, v in TrainConfig(env="push").to_json().items() if k != "horizon_end"}
+    resumed = TrainConfig.from_json({**before, "horizon": 8})
+    assert (resumed.horizon, resumed.horizon_end) == (8, 0)
+    assert "horizon_end" not in identity(resumed)
+    assert identity(TrainConfig(env="push"))["horizon_end"] == 8

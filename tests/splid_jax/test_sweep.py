@@ -57,6 +57,16 @@ def test_vary_horizon_end_lets_each_member_anneal_its_own_horizon(tmp_path):
     assert horizons == {0: [6, 6], 2: [5, 2]}  # iterations 2 and 4 of a fall from 6 to 2 over 4
 
 
+def test_members_take_the_tasks_falling_horizon_unless_horizons_are_given(tmp_path):
+    given = {"env": "push", "run_dir": str(tmp_path)}
+    _, lanes = sweep.grid_configs(given, 2, (1.0,), None)
+    assert {(m.horizon, m.horizon_end) for m in lanes} == {(12, 8)}
+    _, lanes = sweep.grid_configs(given, 1, (1.0,), (4, 8))
+    assert [(m.horizon, m.horizon_end) for m in lanes] == [(4, 0), (8, 0)]  # each H throughout
+    _, lanes = sweep.grid_configs(given, 1, (1.0,), None, {"horizon_end": (0, 6)})
+    assert [(m.horizon, m.horizon_end) for m in lanes] == [(12, 0), (12, 6)]
+
+
 @pytest.mark.parametrize(
     "vary, field",
     [
