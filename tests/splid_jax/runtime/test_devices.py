@@ -30,7 +30,10 @@ for algo in ("splid", "gcsl"):
     one, two = Trainer(env, cfg), Trainer(env, cfg, devices.place(2, cfg.num_envs, devices.ENVS).mesh)
     ts = one.init(jax.random.PRNGKey(3))
     a, b = jax.jit(one.iteration)(ts, one.hyper()), jax.jit(two.iteration)(ts, two.hyper())
-    same = jax.tree.map(lambda x, y: bool(np.array_equal(np.asarray(x), np.asarray(y))), a, b)
+    # counts and flags alike, floats to rounding: XLA:CPU may vectorise 8 envs and 2 x 4 apart
+    close = lambda x, y: bool(np.allclose(x, y, rtol=1e-5, atol=1e-6) if np.issubdtype(x.dtype, np.floating)
+                              else np.array_equal(x, y))
+    same = jax.tree.map(lambda x, y: close(np.asarray(x), np.asarray(y)), a, b)
     out[algo] = [all(jax.tree.leaves(same)), int(a[1]["select_accepted"])]
 
 # a sweep whose members are split: against one device, and resumed after a stop
@@ -74,7 +77,7 @@ def two_devices(tmp_path_factory) -> dict:
     return json.loads(run.stdout.strip().splitlines()[-1])
 
 
-def test_a_run_split_by_envs_computes_the_one_device_iteration_exactly(two_devices):
+def test_a_run_split_by_envs_computes_the_one_device_iteration_to_rounding(two_devices):
     assert two_devices["splid"][0] and two_devices["gcsl"][0]
     assert two_devices["splid"][1] > 0  # SELECT kept pairs: real candidates were gathered and compared
 
