@@ -4,6 +4,8 @@ and those that never reach it, with what the gripper and the object do at the go
 
     python experiments/goal_leaving.py RUN_DIR --episodes 500 --out leaving.json
 
+RUN_DIR is a run of train or a sweep's member.
+
 Fetch tasks with an object only (the gripper's position is the observation's first three entries)."""
 
 from __future__ import annotations
@@ -14,7 +16,10 @@ import json
 import jax
 import numpy as np
 
-from splid_jax.rollout import load_config, load_policy, rollout
+from splid_jax.common.errors import InvalidConfig
+from splid_jax.reference.policy import EvaluationError, load_run
+from splid_jax.rollout import rollout
+from splid_jax.runtime.checkpoint import CheckpointError
 
 
 def median(x) -> float | None:
@@ -85,14 +90,16 @@ def main() -> None:
     p.add_argument("--step", type=int, default=None, help="checkpoint (default: the newest)")
     p.add_argument("--out", default=None, help="write the figures as JSON here")
     a = p.parse_args()
-    cfg = load_config(a.run_dir)
-    env, trainer, state, step = load_policy(cfg, a.step)
+    try:  # a run of train, or a sweep's member (sliced out of the sweep's stacked checkpoint)
+        _, env, trainer, pstate, step = load_run(a.run_dir, a.step)
+    except (InvalidConfig, EvaluationError, CheckpointError) as e:
+        p.exit(2, f"{p.prog}: error: {e}\n")
 
     def episodes(pstate, key):
         states = rollout(env, trainer, pstate, key, a.episodes)
         return states, jax.vmap(lambda o, g: trainer.policy.act(pstate, o, g))(states.obs, states.desired_goal)
 
-    states, actions = jax.jit(episodes)(state.policy, jax.random.PRNGKey(a.seed))
+    states, actions = jax.jit(episodes)(pstate, jax.random.PRNGKey(a.seed))
     out = {"run_dir": a.run_dir, "iteration": step, "seed": a.seed, **analyse(env.evaluation_task(), states, actions)}
     text = json.dumps(out, indent=1)
     print(text)

@@ -113,10 +113,12 @@ def grid_configs(
     """The sweep's and its members' configs from the explicit settings ``given``. Without ``horizons``
     the members take the task's own H and the horizon it falls to; a given H is kept throughout unless
     ``horizon_end`` is given too, as with ``train --horizon``."""
-    own = {} if horizons else {"horizon": TrainConfig(**given).horizon}
-    grid = members(seeds, sigmas, horizons or (own["horizon"],), base_seed=given.get("seed", 0), varied=varied)
-    given = {**given, "sigma": max(sigmas), **({} if own else {"horizon": max(horizons)})}
-    return member_configs(TrainConfig(**given), grid)
+    task_h = None if horizons else TrainConfig(**given).horizon
+    grid = members(seeds, sigmas, horizons or (task_h,), base_seed=given.get("seed", 0), varied=varied)
+    fixed = {**given, "sigma": max(sigmas)}
+    if horizons:  # shapes for the largest H, as a sweep's
+        fixed["horizon"] = max(horizons)
+    return member_configs(TrainConfig(**fixed), grid)
 
 
 def run_sweep(cfg: TrainConfig, grid: list[Member], quiet: bool = False, resume: bool = False) -> list[dict]:
