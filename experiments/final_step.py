@@ -1,7 +1,7 @@
 """Why a policy reaches the goal but does not stay, and what holds it there: seeds of one setting as
 one vmapped program, learning curves on both success measures, then per-step traces of the final
 policies' evaluation episodes (distance to goal, share at the goal at each step, the object's speed
-at the first hit) and the SELECT candidates' make-up.
+at the first hit), the SELECT candidates' make-up and what the relabel buffer holds at the end.
 
     python experiments/final_step.py --env push --seeds 5 --iterations 80 \
         --set relabel=paper --set relabel=hold --out experiments/results/2026-11-23/final-step-push
@@ -72,6 +72,34 @@ def traces(env, trainer: Trainer, pstate, key, episodes: int) -> dict:
     }
 
 
+def buffer_make_up(env, buf) -> dict:
+    """What the relabel buffer holds at the end of training, for object tasks: the share of pairs whose
+    goal is where the object already is (held goals), whose goal is lifted above the object's resting
+    height (PickAndPlace's goals in the air), whose state has the object lifted, and how far the other
+    goals lie from the object (m)."""
+    start = getattr(env, "achieved_goal_start", None)
+    rest_z = getattr(getattr(env, "layout", None), "object_rest_z", None)
+    if not getattr(env, "has_object", False) or start is None or rest_z is None:
+        return {}
+    filled = jnp.arange(buf.obs.shape[0]) < buf.size
+    obj = buf.obs[:, start : start + 3]
+    dist = jnp.linalg.norm(buf.goal - obj, axis=-1)
+    held = dist < env.success_distance
+
+    def share(x, where=filled):
+        return jnp.sum(x & where) / jnp.maximum(jnp.sum(where), 1)
+
+    moved = filled & ~held
+    return {
+        "pairs": buf.size,
+        "held_goal_share": share(held),
+        "lifted_goal_share": share(buf.goal[:, 2] > rest_z + 0.01),
+        "lifted_state_share": share(obj[:, 2] > rest_z + 0.01),
+        "moved_goal_distance_median": jnp.nanmedian(jnp.where(moved, dist, jnp.nan)),
+        "moved_goal_distance_p90": jnp.nanpercentile(jnp.where(moved, dist, jnp.nan), 90),
+    }
+
+
 def arm_path(out: str, env_name: str, fields: dict) -> str:
     name = "-".join(f"{k}{v}" for k, v in fields.items()) or "default"
     name = "".join(c if c.isalnum() or c in "._-" else "_" for c in name)  # a file name, whatever the values
@@ -131,10 +159,14 @@ def run_arm(
     tr = jax.jit(jax.vmap(lambda ps, k: traces(env, trainer, ps, k, trace_episodes)))(
         state.policy, jax.random.split(jax.random.PRNGKey(7), seeds)
     )
+    buffer = {}
+    if hasattr(state, "buffer") and hasattr(state.buffer, "goal"):  # the cloning learners' relabel buffer
+        buffer = jax.device_get(jax.vmap(lambda b: buffer_make_up(env, b))(state.buffer))
     return {
         **record,
         "curve": curve,
         "traces": {k: np.asarray(v).tolist() for k, v in jax.device_get(tr).items()},
+        "buffer": {k: np.asarray(v).tolist() for k, v in buffer.items()},
     }
 
 
@@ -219,6 +251,9 @@ def main() -> None:
             f"compile {r['compile_s']:.1f}s",
             flush=True,
         )
+        if r["buffer"]:
+            made = ", ".join(f"{k} {np.mean(v):.3f}" for k, v in r["buffer"].items())
+            print(f"{r['fields']}: buffer {made}", flush=True)
     figure(results, os.path.join(a.out, f"{a.env}-traces.png"))
 
 
