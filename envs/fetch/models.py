@@ -59,6 +59,14 @@ GRIPPER_MASS = 4.0  # palm + fingers, the mass the xyz drive moves
 DRIVE_OMEGA = 50.0  # rad/s: the reference weld's time constant 0.02 s
 FINGER_KP = 30000.0
 FINGER_MASS = 1.0
+# How PickAndPlace's finger joints respond to their position actuators (kp 30000 as the reference's):
+# "reference" as the reference's joints, whose 4 kg fingers carry an armature of 100 and a damping of 1000
+# (about 17 rad/s, underdamped: they close in about 0.1 s); "fast" 1 kg fingers, critically damped, without
+# armature (173 rad/s), which slam shut at up to about 8 m/s and under exploration noise throw the cube
+# (`experiments/random_lift.py`).
+FINGER_DRIVES = ("reference", "fast")
+REFERENCE_FINGER_INERTIA = 104.0  # kg along the joint: the reference finger's 4 kg and its armature of 100
+REFERENCE_FINGER_DAMPING = 1000.0
 # Slide only (see the module docstring): the reference arm's effective mass at the grip site, the
 # fingertip corners that strike the puck, and their contact with it.
 SLIDE_GRIPPER_MASS = 13.0
@@ -188,6 +196,7 @@ def mjcf(
     drive_damping: str = "joint",
     drive: str = "pd",
     finger_table: float = 0.0,
+    finger_drive: str = "reference",
 ) -> str:
     """The MJCF text of task ``kind`` (one of ``KINDS``); ``table`` is the table's collision shape
     (``tables_for(kind)``), ``finger`` the closed finger block's (``fingers_for(kind)``).
@@ -206,7 +215,9 @@ def mjcf(
 
     ``finger_table`` > 0 (Reach, Push, PickAndPlace): the fingers reach ``REFERENCE_FINGER_BELOW_SITE``
     below the grip site and touch the table with this friction (condim 3), so a gripper driven down at
-    the table presses on it and drags, as the reference's does under its mocap weld; 0: no such contact."""
+    the table presses on it and drags, as the reference's does under its mocap weld; 0: no such contact.
+
+    ``finger_drive`` (PickAndPlace's free fingers): one of ``FINGER_DRIVES``, see there."""
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
     if table not in tables_for(kind):
@@ -221,6 +232,8 @@ def mjcf(
         raise ValueError(f"drive_damping must be 'joint' or 'actuator', got {drive_damping!r}")
     if drive not in DRIVES:
         raise ValueError(f"drive must be one of {DRIVES}, got {drive!r}")
+    if finger_drive not in FINGER_DRIVES:
+        raise ValueError(f"finger_drive must be one of {FINGER_DRIVES}, got {finger_drive!r}")
     if finger_table < 0 or (finger_table > 0 and kind == "slide"):
         raise ValueError(f"finger_table must be >= 0 (0 on slide), got {finger_table}")
     (tx, ty, tz), (hx, hy, hz), (gx, gy, gz) = _SCENES[kind]
@@ -257,15 +270,19 @@ def mjcf(
           rgba="0.6 0.5 0.4 1"/>"""
 
     if free_fingers:
-        fdamp = 2.0 * FINGER_MASS * np.sqrt(FINGER_KP / FINGER_MASS)
+        if finger_drive == "reference":
+            fdamp, armature = REFERENCE_FINGER_DAMPING, REFERENCE_FINGER_INERTIA - FINGER_MASS
+        else:
+            fdamp, armature = 2.0 * FINGER_MASS * np.sqrt(FINGER_KP / FINGER_MASS), 0.0
+        fjoint = f'type="slide" range="0 0.05" damping="{fdamp:.6g}" armature="{armature:.6g}"'
         fingers = f"""
       <body name="finger_l">
-        <joint name="finger_l" type="slide" axis="0 1 0" range="0 0.05" damping="{fdamp:.6g}"/>
+        <joint name="finger_l" axis="0 1 0" {fjoint}/>
         <geom name="finger_l" type="box" size="0.01 0.006 0.03" pos="0 0.006 {finger_z:.6g}"
               mass="{FINGER_MASS}" {nograv} rgba="0.3 0.3 0.3 1"/>
       </body>
       <body name="finger_r">
-        <joint name="finger_r" type="slide" axis="0 -1 0" range="0 0.05" damping="{fdamp:.6g}"/>
+        <joint name="finger_r" axis="0 -1 0" {fjoint}/>
         <geom name="finger_r" type="box" size="0.01 0.006 0.03" pos="0 -0.006 {finger_z:.6g}"
               mass="{FINGER_MASS}" {nograv} rgba="0.3 0.3 0.3 1"/>
       </body>"""

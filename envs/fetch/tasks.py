@@ -179,10 +179,9 @@ class _FetchTask(GoalEnv):
         return self.timestep * self.substeps
 
     # ---- model -------------------------------------------------------------------------------
-    @property
-    def built(self):
-        return models.build(
-            self.kind,
+    def model_options(self) -> dict:
+        """``models.mjcf``'s keywords this task sets."""
+        return dict(
             timestep=float(self.timestep),
             iterations=int(self.iterations),
             ls_iterations=int(self.ls_iterations),
@@ -191,6 +190,10 @@ class _FetchTask(GoalEnv):
             drive=str(self.drive),
             finger_table=float(self.finger_table),
         )
+
+    @property
+    def built(self):
+        return models.build(self.kind, **self.model_options())
 
     @property
     def mj_model(self):
@@ -394,9 +397,20 @@ class Slide(_FetchTask):
 class PickAndPlace(_FetchTask):
     """Carry a cube to a goal on the table or, half the time, up to 0.45 m above it."""
 
+    # the finger joints' response to their actuators (models.FINGER_DRIVES): the reference's, or the fast one
+    finger_drive: str = experimental("reference")
     kind = "pick_and_place"
     block_gripper = False
     target_in_the_air = True
+
+    def __post_init__(self):
+        super().__post_init__()
+        drives = models.FINGER_DRIVES
+        ok = self.finger_drive in drives
+        check(ok, f"{self.kind}.finger_drive", self.finger_drive, "one of " + ", ".join(drives))
+
+    def model_options(self) -> dict:
+        return {**super().model_options(), "finger_drive": str(self.finger_drive)}
 
 
 TASKS = {"reach": Reach, "push": Push, "slide": Slide, "pick_and_place": PickAndPlace}

@@ -132,6 +132,7 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("reach", "floor_clearance", -0.01),
         ("slide", "finger_table", 1.0),  # the puck is struck by fingertips, not the finger block
         ("push", "finger_table", -1.0),
+        ("pick_and_place", "finger_drive", "instant"),
     ],
 )
 def test_bad_overrides_fail_naming_the_field(name, field, value):
@@ -308,6 +309,28 @@ def test_weld_drive_pulls_the_gripper_onto_its_mocap_target():
     for _ in range(250):  # 0.5 s: ten time constants of the constraint
         mujoco.mj_step(m, d)
     np.testing.assert_allclose(d.qpos[g : g + 3], [0.05, -0.03, 0.02], atol=1e-3)
+
+
+@pytest.mark.parametrize("drive, fastest", [("reference", 1.0), ("fast", None)])
+def test_pick_and_place_fingers_close_as_slowly_as_the_references(drive, fastest):
+    """The reference's finger joints carry an armature of 100 and a damping of 1000: they take about 0.1 s to
+    close and never move at 1 m/s; the fast drive's shut within one control step at several m/s."""
+    m = mujoco.MjModel.from_xml_string(models.mjcf("pick_and_place", 0.004, 4, 4, finger_drive=drive))
+    d = mujoco.MjData(m)
+    q, v = m.joint("finger_l").qposadr[0], m.joint("finger_l").dofadr[0]
+    d.qpos[[q, q + 1]] = 0.05  # open
+    d.ctrl[3:5] = 0.0  # close
+    speeds, path = [], []
+    for _ in range(75):  # 0.3 s
+        mujoco.mj_step(m, d)
+        speeds.append(abs(d.qvel[v]))
+        path.append(d.qpos[q])
+    first_step = path[9]  # after one 40 ms control step
+    if fastest is None:
+        assert first_step < 0.005 and max(speeds) > 3.0
+    else:
+        assert first_step > 0.03 and max(speeds) < fastest
+        assert path[-1] < 0.005  # yet it does close
 
 
 # ---- physics: one compiled program per task (conftest.FetchEpisodes) -------------------------------
