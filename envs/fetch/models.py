@@ -13,7 +13,8 @@ Every geom is a primitive with ``contype = conaffinity = 0``; the only collision
 - Reach: the reference's gripper hangs on a 7-joint arm, ours on none, so ``within_reach`` keeps the
   target within the arm's measured reach (task field ``workspace``); only Slide's goals exceed it.
 - Fingers: one fixed closed block for Reach, Push and Slide; for PickAndPlace two slide joints with
-  position actuators (kp 30000, range 0..0.05, as the reference). With ``finger_table`` (Push's default)
+  position actuators (kp 30000, range 0..0.05) and, by default, the reference's joint armature and damping
+  (``FINGER_DRIVES``). With ``finger_table`` (Push's default)
   they reach as far down as the reference's and press and drag on the table as its fingers do.
 - Table: its top face is a plane at z = 0.4, a cheaper contact than the reference's box
   (``table="box"`` gives the box). An object pushed past an edge glides on instead of falling; every
