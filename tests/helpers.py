@@ -50,14 +50,14 @@ def random_policy_success(env: GoalEnv, episodes: int = 256) -> float:
     return float(jnp.mean(jax.jit(jax.vmap(episode))(jax.random.split(jax.random.PRNGKey(7), episodes))))
 
 
-def with_counted_jit(learner):
-    """``learner`` with ``jitted``, its jitted chunk, and ``traces``, how often Python traced it: one
-    per compilation."""
+def with_counted_jit(learner, compiler_options=None):
+    """``learner`` with ``jitted``, its jitted chunk (compiled with ``compiler_options``), and ``traces``,
+    how often Python traced it: one per compilation."""
     learner.traces = 0
 
     def counted(state, hyper):
         learner.traces += 1
         return learner.chunk(state, hyper)
 
-    learner.jitted = jax.jit(counted)
+    learner.jitted = jax.jit(counted, compiler_options=compiler_options)
     return learner
