@@ -435,20 +435,20 @@ def test_struck_slide_puck_stays_flat_on_the_table(fetch):
 def test_grasped_starts_put_the_cube_between_the_fingers_and_evaluation_starts_standard():
     env = envs.make("pick_and_place", grasped_starts=1.0)
     lay = env.layout
-    state = jax.vmap(env.reset)(jax.random.split(jax.random.PRNGKey(0), 16))
+    state = jax.jit(jax.vmap(env.reset))(jax.random.split(jax.random.PRNGKey(0), 16))  # one compile, not op by op
     obj, grip, fingers = state.obs[:, 3:6], state.obs[:, 0:3], state.obs[:, 9:11]
     np.testing.assert_allclose(obj - grip, np.tile([0.0, 0.0, tasks.GRASP_ABOVE_SITE], (16, 1)), atol=1e-6)
     np.testing.assert_allclose(fingers, models.OBJECT_HALF, atol=1e-6)  # inner faces on the cube's sides
     standard = env.evaluation_task()
     assert standard.grasped_starts == 0.0 and standard.layout == lay
-    start = jax.vmap(standard.reset)(jax.random.split(jax.random.PRNGKey(0), 16))
+    start = jax.jit(jax.vmap(standard.reset))(jax.random.split(jax.random.PRNGKey(0), 16))
     np.testing.assert_allclose(start.obs[:, 5], lay.object_rest_z, atol=1e-6)  # every cube on the table
     assert np.all(np.linalg.norm(start.obs[:, 3:5] - start.obs[:, 0:2], axis=-1) >= tasks.MIN_OBJECT_DISTANCE - 1e-6)
 
 
 def test_grasped_starts_mix_by_share_and_need_free_fingers():
     env = envs.make("pick_and_place", grasped_starts=0.5)
-    state = jax.vmap(env.reset)(jax.random.split(jax.random.PRNGKey(1), 400))
+    state = jax.jit(jax.vmap(env.reset))(jax.random.split(jax.random.PRNGKey(1), 400))
     held = np.asarray(state.obs[:, 5] > env.layout.object_rest_z + 0.05)
     assert 0.4 < held.mean() < 0.6
     assert envs.make("push").evaluation_task() == envs.make("push")
@@ -467,12 +467,14 @@ def test_floor_clearance_raises_the_lowest_gripper_target():
         assert target[2] == pytest.approx(low[2] + clearance, abs=1e-6)
 
 
+def _object_moved_away(physics, lay):
+    return physics.replace(qpos=physics.qpos.at[..., lay.object_q : lay.object_q + 2].set(jnp.array([1.6, 0.4])))
+
+
 def _pressed_paths(env, action, steps=6):
     """Grip positions [steps + 1, 3] under ``action`` held from the start (the object moved out of the way)."""
     state = env.reset(jax.random.PRNGKey(0))
-    lay = env.layout
-    qpos = state.physics.qpos.at[lay.object_q : lay.object_q + 2].set(jnp.array([1.6, 0.4]))
-    state = state.replace(physics=state.physics.replace(qpos=qpos))
+    state = state.replace(physics=_object_moved_away(state.physics, env.layout))
     step = jax.jit(env.step)
     path = [np.asarray(state.obs[:3])]
     for _ in range(steps):
@@ -481,15 +483,28 @@ def _pressed_paths(env, action, steps=6):
     return np.array(path)
 
 
-def test_finger_table_contact_drags_a_gripper_pressed_on_the_table():
+def _pressed_paths_in_the_episode_program(fetch, env, actions, steps=6):
+    """``_pressed_paths`` of each of ``actions`` [n, 4] at once, [n, steps + 1, 3], from the task's episode
+    program (``fetch``)."""
+    n = len(actions)
+    state = fetch.reset(env)
+    state = state.replace(physics=_object_moved_away(state.physics, env.layout))
+    held = np.broadcast_to(np.resize(np.asarray(actions, np.float32), (fetch.B, 4)), (fetch.T, fetch.B, 4))
+    after = np.asarray(fetch.run(env, held, state=state)[2].obs)[:steps, :n, :3]
+    return np.concatenate([np.asarray(state.obs)[None, :n, :3], after]).swapaxes(0, 1)
+
+
+@pytest.mark.slow
+def test_finger_table_contact_drags_a_gripper_pressed_on_the_table(fetch):
     with_contact = envs.make("push", finger_table=1.0)
-    free = _pressed_paths(with_contact, [0.0, 1.0, 0.0, 0.0])
-    pressed = _pressed_paths(with_contact, [0.0, 1.0, -1.0, 0.0])
+    assert envs.make("push") == with_contact  # Push's default: the episode program the tests above compiled
+    free, pressed = _pressed_paths_in_the_episode_program(
+        fetch, with_contact, [[0.0, 1.0, 0.0, 0.0], [0.0, 1.0, -1.0, 0.0]]
+    )
     speed = lambda p: np.linalg.norm(np.diff(p[2:, :2], axis=0), axis=-1).mean()  # noqa: E731
     assert speed(pressed) < 0.7 * speed(free)  # the reference: 16 against 33 mm per step
     table_height = models.TABLE_TOP + models.REFERENCE_FINGER_BELOW_SITE
     assert pressed[:, 2].min() > table_height - 0.005  # the table, not the workspace floor, holds it
-    assert envs.make("push") == with_contact  # Push's default
     without = _pressed_paths(envs.make("push", finger_table=0.0), [0.0, 1.0, -1.0, 0.0])
     assert speed(without) == pytest.approx(speed(free), rel=0.05)  # no contact: pressing costs nothing
     assert without[-1, 2] < table_height - 0.005
