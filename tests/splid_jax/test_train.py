@@ -24,6 +24,8 @@ from splid_jax.train import RunStopped, main, run
 TINY = ["--env", "point", "--num-envs", "8", "--eval-episodes", "16", "--bc-steps", "40", "--batch-size", "64",
         "--hidden", "32,32", "--eval-every", "5"]  # fmt: skip
 VOLATILE = {"wall_s", "steps_per_s"}
+# TINY's run in-process: the programs its first run compiled come from the compile cache
+TINY_CONFIG = dict(env="point", num_envs=8, eval_episodes=16, bc_steps=40, batch_size=64, hidden=(32, 32), eval_every=5)
 
 
 # A shell starts background jobs with SIGINT ignored, and a child inherits that: the Ctrl-C test would
@@ -211,8 +213,7 @@ def test_ctrl_c_saves_and_exits_cleanly(tmp_path):
 
 @pytest.mark.slow
 def test_nan_stops_the_run_and_keeps_the_last_good_checkpoint(tmp_path):
-    cfg = TrainConfig(env="point", num_envs=8, eval_episodes=16, bc_steps=5, batch_size=32, hidden=(16,),
-                      eval_every=5, iterations=20, learning_rate=1e38, run_dir=str(tmp_path / "run"))  # fmt: skip
+    cfg = TrainConfig(**TINY_CONFIG, iterations=20, learning_rate=1e38, run_dir=str(tmp_path / "run"))
     with pytest.raises(RunStopped, match="non-finite"):
         run(cfg, quiet=True)
     step = checkpoint.latest_step(cfg.run_dir)
@@ -261,8 +262,7 @@ def test_resume_under_changed_task_defaults_fails_naming_the_option(tmp_path):
     import envs
     from splid_jax.runtime.checkpoint import CheckpointError
 
-    cfg = TrainConfig(env="point", num_envs=4, eval_episodes=4, bc_steps=2, batch_size=16, hidden=(8,),
-                      eval_every=5, iterations=5, run_dir=str(tmp_path / "run"))  # fmt: skip
+    cfg = TrainConfig(**TINY_CONFIG, iterations=5, run_dir=str(tmp_path / "run"))
     run(cfg, env=envs.make("point"), quiet=True)
     longer = TrainConfig(**{**cfg.__dict__, "iterations": 10})
     with pytest.raises(CheckpointError, match=r"env\.door_half_width=0\.75 but env\.door_half_width=0\.5"):
