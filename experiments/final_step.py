@@ -31,6 +31,13 @@ from splid_jax.learners.her.config import HerConfig
 from splid_jax.learners.her.learner import HER
 from splid_jax.learners.splid.trainer import Trainer
 
+LIFTED = 0.01  # m above where the object rests: a goal in the air, an object off the table
+
+
+def share(x, where):
+    """The share of ``where`` at which ``x`` holds (0 where nothing is)."""
+    return jnp.sum(x & where) / jnp.maximum(jnp.sum(where), 1)
+
 
 def traces(env, trainer: Trainer, pstate, key, episodes: int) -> dict:
     """Per-step distance to the goal and success of the deterministic policy, and the achieved goal's
@@ -50,13 +57,10 @@ def traces(env, trainer: Trainer, pstate, key, episodes: int) -> dict:
     speed_at_hit = jnp.where(hit, jnp.take_along_axis(speed, first[None], axis=0)[0], jnp.nan)
     stays = hit & jnp.all(jnp.where(jnp.arange(env.episode_length)[:, None] >= first[None], succ, True), axis=0)
     # goals above where the object rests (PickAndPlace's half in the air) against goals on the table
-    air = start.desired_goal[:, -1] - start.achieved_goal[:, -1] > 0.01
+    air = start.desired_goal[:, -1] - start.achieved_goal[:, -1] > LIFTED
     if start.desired_goal.shape[-1] != 3:  # planar goals have no height
         air = jnp.zeros_like(air)
     final = succ[-1]
-
-    def share(x, where):
-        return jnp.sum(x & where) / jnp.maximum(jnp.sum(where), 1)
 
     return {
         "air_goal_share": jnp.mean(air),
@@ -77,24 +81,19 @@ def buffer_make_up(env, buf) -> dict:
     goal is where the object already is (held goals), whose goal is lifted above the object's resting
     height (PickAndPlace's goals in the air), whose state has the object lifted, and how far the other
     goals lie from the object (m)."""
-    start = getattr(env, "achieved_goal_start", None)
-    rest_z = getattr(getattr(env, "layout", None), "object_rest_z", None)
-    if not getattr(env, "has_object", False) or start is None or rest_z is None:
+    if not getattr(env, "has_object", False):  # the Fetch tasks with an object, whose layout has its height
         return {}
+    rest_z, start = env.layout.object_rest_z, env.achieved_goal_start
     filled = jnp.arange(buf.obs.shape[0]) < buf.size
     obj = buf.obs[:, start : start + 3]
     dist = jnp.linalg.norm(buf.goal - obj, axis=-1)
     held = dist < env.success_distance
-
-    def share(x, where=filled):
-        return jnp.sum(x & where) / jnp.maximum(jnp.sum(where), 1)
-
     moved = filled & ~held
     return {
         "pairs": buf.size,
-        "held_goal_share": share(held),
-        "lifted_goal_share": share(buf.goal[:, 2] > rest_z + 0.01),
-        "lifted_state_share": share(obj[:, 2] > rest_z + 0.01),
+        "held_goal_share": share(held, filled),
+        "lifted_goal_share": share(buf.goal[:, 2] > rest_z + LIFTED, filled),
+        "lifted_state_share": share(obj[:, 2] > rest_z + LIFTED, filled),
         "moved_goal_distance_median": jnp.nanmedian(jnp.where(moved, dist, jnp.nan)),
         "moved_goal_distance_p90": jnp.nanpercentile(jnp.where(moved, dist, jnp.nan), 90),
     }
