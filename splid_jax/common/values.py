@@ -24,6 +24,11 @@ def parse_overrides(text: str, field: str = "env_options") -> dict:
     return overrides
 
 
+def format_overrides(overrides: dict) -> str:
+    """``parse_overrides``'s inverse: ``{"finger": "capsule", "substeps": 20}`` -> ``"finger=capsule,substeps=20"``."""
+    return ",".join(f"{key}={value}" for key, value in overrides.items())
+
+
 def read_value(text: str) -> int | float | str:
     """A setting's text as an integer, else a float, else the word itself."""
     try:

@@ -112,3 +112,13 @@ def test_push_horizon_falls_from_12_to_8_unless_the_caller_sets_h():
     assert (resumed.horizon, resumed.horizon_end) == (8, 0)
     assert "horizon_end" not in identity(resumed)
     assert identity(TrainConfig(env="push"))["horizon_end"] == 8
+
+
+def test_pick_and_place_trains_from_grasped_starts_unless_told_otherwise():
+    assert TrainConfig(env="pick_and_place").env_overrides() == {"grasped_starts": 0.5}
+    assert TrainConfig(env="pick_and_place", algo="her").env_overrides() == {"grasped_starts": 0.5}
+    given = TrainConfig(env="pick_and_place", env_options="finger_drive=fast")  # the task's option stays
+    assert given.env_overrides() == {"grasped_starts": 0.5, "finger_drive": "fast"}
+    assert TrainConfig(env="pick_and_place", env_options="grasped_starts=0").env_overrides() == {"grasped_starts": 0}
+    assert TrainConfig.from_json(given.to_json()) == given  # resolved once: a saved run reads back the same
+    assert TrainConfig(env="push").env_options == ""
