@@ -248,8 +248,12 @@ class TrainConfig:
 
     @classmethod
     def from_json(cls, saved: dict[str, Any], **changes) -> TrainConfig:
-        """A config from a run's config.json, which also records the hardware it ran on."""
-        return cls(**{**{k: v for k, v in saved.items() if k not in PROVENANCE}, **changes})
+        """A config from a run's config.json, which also records the hardware it ran on. Its task options
+        are whole as saved: a run recorded before a task gained a default option resumes as it ran."""
+        cfg = cls(**{**{k: v for k, v in saved.items() if k not in PROVENANCE}, **changes})
+        if "env_options" not in changes and isinstance(saved.get("env_options"), str):
+            object.__setattr__(cfg, "env_options", format_overrides(parse_overrides(saved["env_options"])))
+        return cfg
 
 
 _POINT = dict(

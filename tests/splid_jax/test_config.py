@@ -121,4 +121,6 @@ def test_pick_and_place_trains_from_grasped_starts_unless_told_otherwise():
     assert given.env_overrides() == {"grasped_starts": 0.5, "finger_drive": "fast"}
     assert TrainConfig(env="pick_and_place", env_options="grasped_starts=0").env_overrides() == {"grasped_starts": 0}
     assert TrainConfig.from_json(given.to_json()) == given  # resolved once: a saved run reads back the same
+    before = {**TrainConfig(env="pick_and_place").to_json(), "env_options": ""}  # saved before the default
+    assert TrainConfig.from_json(before).env_overrides() == {}  # resumes from the standard starts it trained on
     assert TrainConfig(env="push").env_options == ""
