@@ -35,6 +35,13 @@ def _written_out(cond, body, val, trips: int):
     return val
 
 
+def writes_out(choice: str, backend: str) -> bool:
+    """Whether a task's ``solver_loops`` choice writes the solver out on ``backend``: ``auto`` does so on a
+    GPU only, where the loops' host round trips cost (an XLA:CPU loop reads no condition back, and the
+    written-out solver there compiles twice as long and steps slower)."""
+    return choice == "unrolled" or (choice == "auto" and backend == "gpu")
+
+
 @contextlib.contextmanager
 def unrolled_in_mjx(iterations: int, enabled: bool = True):
     """Within the block, MJX's Newton loop runs ``iterations`` written-out trips and its line search

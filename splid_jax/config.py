@@ -185,8 +185,13 @@ class TrainConfig:
                 f"{per_generation} episodes per generation",
             )
             object.__setattr__(self, "num_envs", per_generation)
-        defaults = {**TASK_DEFAULTS[self.env], **learner.task_defaults.get(self.env, {})}
-        options = {**parse_overrides(defaults.pop("env_options", "")), **parse_overrides(self.env_options or "")}
+        task, own = TASK_DEFAULTS[self.env], learner.task_defaults.get(self.env, {})
+        defaults = {k: v for k, v in {**task, **own}.items() if k != "env_options"}
+        options = {  # option by option: the task's, the learner's on that task, then the given ones
+            **parse_overrides(task.get("env_options", "")),
+            **parse_overrides(own.get("env_options", "")),
+            **parse_overrides(self.env_options or ""),
+        }
         object.__setattr__(self, "env_options", format_overrides(options))
         if self.horizon_end is None:  # a task's falling horizon goes with its own H, not with one the caller set
             task_end = defaults["horizon_end"] if self.horizon is None else 0

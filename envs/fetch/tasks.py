@@ -42,7 +42,7 @@ _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4)
 GOAL_LIFT_MAX = 0.45
 GRASP_ABOVE_SITE = 0.01  # a grasped cube's centre above the grip site: inside the fingers' 6 cm height
 CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
-SOLVER_LOOPS = ("loops", "unrolled")  # MJX's solver loops, or written out (envs/solver_loops.py)
+SOLVER_LOOPS = ("loops", "unrolled", "auto")  # MJX's solver loops, written out, or written out on a GPU only
 
 
 @struct.dataclass
@@ -105,7 +105,8 @@ class _FetchTask(GoalEnv):
     finger: str = experimental("box")
     # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     cholesky: str = experimental("unrolled")
-    # MJX's Newton solver as its loops or written out (envs/solver_loops.py): equal to float rounding
+    # MJX's Newton solver as its loops, written out, or written out on a GPU only (auto; envs/solver_loops.py):
+    # equal to float rounding
     solver_loops: str = experimental("loops", numerics_only=True)
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
@@ -335,7 +336,7 @@ class _FetchTask(GoalEnv):
         if self.drive == "weld":  # the constraint pulls the gripper to the mocap body, put at the target
             home = jnp.asarray(self.layout.grip_home, data.mocap_pos.dtype)
             data = data.replace(mocap_pos=data.mocap_pos.at[0].set(home + ctrl[0:3]))
-        written_out = self.solver_loops == "unrolled"
+        written_out = solver_loops.writes_out(self.solver_loops, jax.default_backend())
         with small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"):
             with solver_loops.unrolled_in_mjx(self.iterations, written_out):
                 data = jax.lax.fori_loop(0, self.substeps, lambda _, d: mjx.step(model, d), data)

@@ -32,6 +32,12 @@ def _loop_primitives(**options) -> set[str]:
 def test_written_out_solver_leaves_no_loop_in_the_step():
     assert _loop_primitives() == {"while[", "scan["}  # the Newton loop, its line search (and the substeps)
     assert _loop_primitives(solver_loops="unrolled") == {"scan["}  # the substeps' loop alone
+    assert _loop_primitives(solver_loops="auto") == {"while[", "scan["}  # the loops on the CPU
+
+
+def test_auto_writes_the_solver_out_on_a_gpu_only():
+    assert [solver_loops.writes_out("auto", b) for b in ("gpu", "cpu", "tpu")] == [True, False, False]
+    assert solver_loops.writes_out("unrolled", "cpu") and not solver_loops.writes_out("loops", "gpu")
 
 
 def test_written_out_solver_follows_the_loops_path():
