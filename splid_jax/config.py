@@ -187,7 +187,8 @@ class TrainConfig:
             object.__setattr__(self, "num_envs", per_generation)
         task, own = TASK_DEFAULTS[self.env], learner.task_defaults.get(self.env, {})
         defaults = {k: v for k, v in {**task, **own}.items() if k != "env_options"}
-        options = {  # option by option: the task's, the learner's on that task, then the given ones
+        options = {  # option by option: the task's, the learner's on that task, then the given ones (their
+            # syntax is checked here, the fields where the task is built)
             **parse_overrides(task.get("env_options", "")),
             **parse_overrides(own.get("env_options", "")),
             **parse_overrides(self.env_options or ""),
@@ -228,7 +229,6 @@ class TrainConfig:
             object.__setattr__(self, "run_dir", os.path.join("runs", f"{self.env}-s{self.seed}"))
         check(self.run_dir.strip() != "", "run_dir", self.run_dir, "a directory name, not empty")
         check(not os.path.isfile(self.run_dir), "run_dir", self.run_dir, "a directory, not an existing file")
-        self.env_overrides()  # the syntax; the fields themselves are checked where the task is built
 
     def env_overrides(self) -> dict[str, Any]:
         return parse_overrides(self.env_options)
@@ -254,10 +254,12 @@ class TrainConfig:
     @classmethod
     def from_json(cls, saved: dict[str, Any], **changes) -> TrainConfig:
         """A config from a run's config.json, which also records the hardware it ran on. Its task options
-        are whole as saved: a run recorded before a task gained a default option resumes as it ran."""
+        are whole, and kept as written (the checkpoint's record holds the same text): a run recorded before a
+        task gained a default option resumes as it ran."""
         cfg = cls(**{**{k: v for k, v in saved.items() if k not in PROVENANCE}, **changes})
-        if "env_options" not in changes and isinstance(saved.get("env_options"), str):
-            object.__setattr__(cfg, "env_options", format_overrides(parse_overrides(saved["env_options"])))
+        options = changes.get("env_options", saved.get("env_options"))
+        if isinstance(options, str):  # checked by the construction above
+            object.__setattr__(cfg, "env_options", options)
         return cfg
 
 

@@ -123,4 +123,6 @@ def test_pick_and_place_trains_from_grasped_starts_unless_told_otherwise():
     assert TrainConfig.from_json(given.to_json()) == given  # resolved once: a saved run reads back the same
     before = {**TrainConfig(env="pick_and_place").to_json(), "env_options": ""}  # saved before the default
     assert TrainConfig.from_json(before).env_overrides() == {}  # resumes from the standard starts it trained on
+    spaced = {**before, "env_options": "grasped_starts=0, finger_drive=fast"}  # as a user wrote it then
+    assert TrainConfig.from_json(spaced).env_options == spaced["env_options"]  # as its checkpoint recorded it
     assert TrainConfig(env="push").env_options == ""
