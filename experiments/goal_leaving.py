@@ -91,13 +91,13 @@ def main() -> None:
     p.add_argument("--out", default=None, help="write the figures as JSON here")
     a = p.parse_args()
     try:  # a run of train, or a sweep's member (sliced out of the sweep's stacked checkpoint)
-        _, env, trainer, pstate, step = load_run(a.run_dir, a.step)
+        _, env, policy, pstate, step = load_run(a.run_dir, a.step)
     except (InvalidConfig, EvaluationError, CheckpointError) as e:
         p.exit(2, f"{p.prog}: error: {e}\n")
 
     def episodes(pstate, key):
-        states = rollout(env, trainer, pstate, key, a.episodes)
-        return states, jax.vmap(lambda o, g: trainer.policy.act(pstate, o, g))(states.obs, states.desired_goal)
+        states = rollout(env, policy, pstate, key, a.episodes)
+        return states, jax.vmap(lambda o, g: policy.act(pstate, o, g))(states.obs, states.desired_goal)
 
     states, actions = jax.jit(episodes)(pstate, jax.random.PRNGKey(a.seed))
     out = {"run_dir": a.run_dir, "iteration": step, "seed": a.seed, **analyse(env.evaluation_task(), states, actions)}

@@ -19,23 +19,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from splid_jax.common.subgoals import Steered, steered
 from splid_jax.reference.policy import load_run
 from splid_jax.rollout import rollout
-
-
-class _Subgoals:
-    """The trained policy steered at a subgoal no further than ``reach`` metres from the object, on the
-    line to the goal: goals beyond what its relabelled goals spanned are outside what it was taught."""
-
-    def __init__(self, policy, start: int, reach):
-        self.policy, self._inner, self._start, self._reach = self, policy, start, reach
-
-    def act(self, pstate, obs, goal):
-        obj = obs[..., self._start : self._start + 3]
-        gap = goal - obj
-        far = jnp.linalg.norm(gap, axis=-1, keepdims=True)
-        subgoal = jnp.where(far > self._reach, obj + gap * (self._reach / jnp.maximum(far, 1e-9)), goal)
-        return self._inner.act(pstate, obs, subgoal)
 
 
 def trained_goal_reach(run_dir: str, quantile: float) -> float:
@@ -94,32 +80,59 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("run_dirs", nargs="+")
     p.add_argument("--episodes", type=int, default=500)
     p.add_argument("--seed", type=int, default=0, help="key of the evaluation starts")
-    p.add_argument(
+    steering = p.add_mutually_exclusive_group()
+    steering.add_argument(
+        "--subgoal-reach",
+        type=float,
+        default=None,
+        metavar="M",
+        help="steer the policy at a subgoal on the line to the goal, at most M from the object (0: not at all; "
+        "default: as the run's evaluations did, its eval_subgoal_reach)",
+    )
+    steering.add_argument(
         "--subgoal-quantile",
         type=float,
         default=None,
-        help="steer the policy at a subgoal on the line to the goal, no further from the object than this "
-        "quantile of the distances of its relabel buffer's goals (a run's own, read from its checkpoint)",
+        help="the same, at most this quantile of the distances of its relabel buffer's goals from the object "
+        "(a run's own, read from its checkpoint)",
+    )
+    p.add_argument(
+        "--reference",
+        type=int,
+        default=0,
+        metavar="EPISODES",
+        help="also run each policy (steered as above) for EPISODES in Gymnasium-Robotics' Fetch*-v4 and in our "
+        "task (splid_jax.evaluate's pairing): reference.json",
     )
     p.add_argument("--out", required=True)
     a = p.parse_args(argv)
     rows: list[dict] = []
+    compared: list[dict] = []
     programs: dict = {}  # one compiled rollout per task and learner: a sweep's members share it
     for run_dir in a.run_dirs:
-        cfg, env, trainer, pstate, step = load_run(run_dir)  # a run of train or a member of a sweep
+        cfg, env, policy, pstate, step = load_run(run_dir)  # a run of train or a member of a sweep
+        policy = policy.policy if isinstance(policy, Steered) else policy  # steered below
         shared = (cfg.env, cfg.env_options, cfg.algo, cfg.hidden, cfg.relative_goal, cfg.normalise)
         if shared not in programs:
+            lo = env.achieved_goal_start
             programs[shared] = jax.jit(
-                lambda ps, key, reach, env=env, trainer=trainer: rollout(
-                    env, _Subgoals(trainer.policy, env.achieved_goal_start, reach), ps, key, a.episodes
+                lambda ps, key, reach, env=env, policy=policy, lo=lo: rollout(
+                    env, Steered(policy, (lo, lo + env.goal_size), reach), ps, key, a.episodes
                 )
             )
-        reach = jnp.inf
+        reach = cfg.eval_subgoal_reach if a.subgoal_reach is None else a.subgoal_reach
         if a.subgoal_quantile is not None:
             reach = trained_goal_reach(run_dir, a.subgoal_quantile)
-            print(f"{run_dir}: subgoals within {reach:.3f} m of the object")
-        states = jax.block_until_ready(programs[shared](pstate, jax.random.PRNGKey(a.seed), reach))
+        print(f"{run_dir}: " + (f"subgoals within {reach:.3f} of the object" if reach else "the goal itself"))
+        states = jax.block_until_ready(programs[shared](pstate, jax.random.PRNGKey(a.seed), reach or jnp.inf))
         rows.append(classify(states, env.success_distance))
+        if a.reference:
+            from splid_jax.reference.policy import evaluate
+
+            both = evaluate(run_dir, a.reference, a.seed, loaded=(cfg, env, steered(policy, env, reach), pstate, step))
+            compared.append(both)
+            sides = (f"{s} {both[s]['success_any']:.3f} / {both[s]['success_final']:.3f}" for s in ("ours", "fetch"))
+            print(f"{run_dir}: " + ", ".join(sides))
         print(
             f"{run_dir} (checkpoint {step}): "
             + ", ".join(f"{k} {v}" for k, v in zip(*np.unique(rows[-1]["class"], return_counts=True), strict=True))
@@ -140,6 +153,14 @@ def main(argv: list[str] | None = None) -> int:
     summary["by_distance"] = by_bin(pooled, "object_to_goal", DISTANCE_BINS)
     summary["by_direction"] = by_bin(pooled, "direction", DIRECTION_BINS)
     os.makedirs(a.out, exist_ok=True)
+    if compared:
+        pooled_sides = {
+            side: {m: float(np.mean([c[side][m] for c in compared])) for m in ("success_any", "success_final")}
+            for side in ("ours", "fetch")
+        }
+        with open(os.path.join(a.out, "reference.json"), "w") as fh:
+            json.dump({"episodes_per_run": a.reference, "mean_over_runs": pooled_sides, "runs": compared}, fh, indent=1)
+        print("mean over runs:", pooled_sides)
     np.savez_compressed(os.path.join(a.out, "episodes.npz"), **pooled)
     with open(os.path.join(a.out, "misses.json"), "w") as fh:
         json.dump(summary, fh, indent=1)

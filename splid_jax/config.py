@@ -145,6 +145,14 @@ class TrainConfig:
     )
     eval_every: int = field(None, "iterations per compiled chunk; evaluation, logging and checkpoints come between")
     eval_episodes: int = field(None, "episodes of the deterministic policy per evaluation")
+    eval_subgoal_reach: float = field(
+        None,
+        "evaluations (and splid_jax.evaluate, splid_jax.rollout) give the policy a subgoal on the line to the goal, "
+        "at most this far from the achieved goal (m on the Fetch tasks), and the goal once within it: far goals lie "
+        "beyond those it was taught; success is judged at the goal. 0: the goal itself. Exploration never steers",
+        recorded_when_set=True,
+        unrecorded=0.0,
+    )
     checkpoint_every: int = field(1, "chunks between checkpoints (0: only at the end)")
     num_devices: int = field(
         1,
@@ -224,6 +232,8 @@ class TrainConfig:
             f"a multiple of eval_every={self.eval_every}",
         )
         check(self.eval_episodes >= 1, "eval_episodes", self.eval_episodes, "an integer >= 1")
+        reach = self.eval_subgoal_reach
+        check(reach >= 0, "eval_subgoal_reach", reach, "a distance >= 0 (0: no subgoals)")
         check(self.checkpoint_every >= 0, "checkpoint_every", self.checkpoint_every, "an integer >= 0")
         if self.run_dir is None:
             object.__setattr__(self, "run_dir", os.path.join("runs", f"{self.env}-s{self.seed}"))
@@ -255,8 +265,10 @@ class TrainConfig:
     def from_json(cls, saved: dict[str, Any], **changes) -> TrainConfig:
         """A config from a run's config.json, which also records the hardware it ran on. Its task options
         are whole, and kept as written (the checkpoint's record holds the same text): a run recorded before a
-        task gained a default option resumes as it ran."""
-        cfg = cls(**{**{k: v for k, v in saved.items() if k not in PROVENANCE}, **changes})
+        task gained a default option resumes as it ran; a setting added since reads as those runs behaved
+        (its ``unrecorded`` value)."""
+        unrecorded = {f.name: f.metadata["unrecorded"] for f in dataclasses.fields(cls) if "unrecorded" in f.metadata}
+        cfg = cls(**{**unrecorded, **{k: v for k, v in saved.items() if k not in PROVENANCE}, **changes})
         options = changes.get("env_options", saved.get("env_options"))
         if isinstance(options, str):  # checked by the construction above
             object.__setattr__(cfg, "env_options", options)
@@ -282,6 +294,7 @@ _POINT = dict(
     sigma_anneal=1,
     eval_every=5,
     eval_episodes=200,
+    eval_subgoal_reach=0.0,
 )
 _FETCH = dict(
     relabel="paper",
@@ -302,6 +315,7 @@ _FETCH = dict(
     sigma_anneal=1,
     eval_every=5,
     eval_episodes=500,
+    eval_subgoal_reach=0.0,
 )
 # Push's, Reach's and PickAndPlace's settings are those that learned best where they were compared (on
 # PickAndPlace: with the reference's finger joints, the earlier Push settings, held goals and half the training
@@ -325,6 +339,7 @@ TASK_DEFAULTS: dict[str, dict[str, Any]] = {
         "buffer_size": 50_000,
         "policy_ema": 0.98,
         "learning_rate": 5e-4,
+        "eval_subgoal_reach": 0.19,  # the 90th percentile of the relabel buffer's goal distances at 10,000 episodes
     },
     "slide": {**_FETCH, "iterations": 50, "num_envs": 1024},
     "pick_and_place": {

@@ -18,6 +18,7 @@ from envs.base import step_batch
 from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.common.paths import unreadable
+from splid_jax.common.subgoals import steered
 from splid_jax.config import TrainConfig
 from splid_jax.learners.registry import make_algorithm
 from splid_jax.runtime import checkpoint
@@ -62,12 +63,13 @@ def load_policy(cfg: TrainConfig, step: int | None = None):
     return env, trainer, state, step
 
 
-def rollout(env, trainer, pstate, key, episodes: int):
-    """Episodes of the deterministic policy from the task's standard starts: the states [T + 1, E]."""
+def rollout(env, policy, pstate, key, episodes: int):
+    """Episodes of the deterministic ``policy`` (``act(pstate, obs, goal)``) from the task's standard starts:
+    the states [T + 1, E]."""
     env = env.evaluation_task()
 
     def one_step(s, _):
-        nxt = step_batch(env, s, trainer.policy.act(pstate, s.obs, s.desired_goal))
+        nxt = step_batch(env, s, policy.act(pstate, s.obs, s.desired_goal))
         return nxt, nxt
 
     start = jax.vmap(env.reset)(jax.random.split(key, episodes))
@@ -259,7 +261,8 @@ def main(argv: list[str] | None = None) -> int:
     except (InvalidConfig, checkpoint.CheckpointError) as err:
         print(f"{p.prog}: error: {err}", file=sys.stderr)
         return 2
-    states = jax.jit(lambda ps, k: rollout(env, trainer, ps, k, a.episodes))(state.policy, jax.random.PRNGKey(a.seed))
+    policy = steered(trainer.policy, env, cfg.eval_subgoal_reach)  # as the run's evaluations acted
+    states = jax.jit(lambda ps, k: rollout(env, policy, ps, k, a.episodes))(state.policy, jax.random.PRNGKey(a.seed))
     succ = np.asarray(states.success[1:] & ~states.invalid[1:])
     print(
         f"{a.run_dir} (iteration {step}): success {succ.any(axis=0).mean():.3f} at any step, "

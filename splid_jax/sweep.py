@@ -226,9 +226,10 @@ def resume_configs(run_dir: str, given: dict) -> tuple[TrainConfig, list[TrainCo
     try:
         with open(os.path.join(run_dir, run_files.SWEEP)) as fh:
             saved = json.load(fh)
-        base = TrainConfig(**{**saved["config"], **given, "run_dir": run_dir})
+        base = TrainConfig.from_json({**saved["config"], **given, "run_dir": run_dir})
         lanes = [
-            TrainConfig(**{**m, **given, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in saved["members"]
+            TrainConfig.from_json({**m, **given, "run_dir": os.path.join(run_dir, m["run_dir"])})
+            for m in saved["members"]
         ]
     except (OSError, json.JSONDecodeError, KeyError, TypeError) as e:
         why = f" that can be read ({e.strerror})" if isinstance(e, OSError) and e.errno != errno.ENOENT else ""

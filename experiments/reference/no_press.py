@@ -33,8 +33,8 @@ def no_press(act, floor: float):
 def main(argv: list[str]) -> int:
     run = argv[0]
     floor = float(argv[1]) if len(argv) > 1 and not argv[1].startswith("--") else 0.422
-    cfg, _, trainer, pstate, _ = reference.load_run(run)
-    act = reference.policy_act(trainer, pstate)
+    cfg, _, policy, pstate, _ = reference.load_run(run)
+    act = reference.policy_act(policy, pstate)
     variants = [(f"no press at z <= {floor}", no_press(act, floor))]
     if "--only" not in argv:
         variants.insert(0, ("as trained", act))

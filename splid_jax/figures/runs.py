@@ -16,8 +16,8 @@ def train(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
     loop.write_json(os.path.join(out, SPEC), record)
     for method, ran, sub in sweeps(record):
         run_dir = os.path.join(out, sub)
-        base = TrainConfig(**{**ran["config"], "run_dir": run_dir})
-        lanes = [TrainConfig(**{**m, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in ran["members"]]
+        base = TrainConfig.from_json({**ran["config"], "run_dir": run_dir})
+        lanes = [TrainConfig.from_json({**m, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in ran["members"]]
         again = resume and os.path.isdir(run_dir) and checkpoint.latest_step(run_dir) is not None
         progress.show(
             f"{record['figure']} {method}: {len(lanes)} members, {base.iterations} iterations x "

@@ -13,6 +13,7 @@ import jax.numpy as jnp
 
 from envs.base import GoalEnv
 from splid_jax.common.evaluation import evaluate
+from splid_jax.common.subgoals import steered
 
 # Keys every chunk's metrics carry (one scalar per member of a sweep), whatever the algorithm.
 EVAL_KEYS = ("eval_success", "eval_success_final", "eval_return")
@@ -80,7 +81,8 @@ class Chunked:
             lambda s, _: self.iteration(s, hyper), state, None, length=self.cfg.eval_every
         )
         key, k_eval = jax.random.split(state.key)
-        metrics = evaluate(self.env, self.policy, state.policy, k_eval, self.cfg.eval_episodes)
+        policy = steered(self.policy, self.env, self.cfg.eval_subgoal_reach)
+        metrics = evaluate(self.env, policy, state.policy, k_eval, self.cfg.eval_episodes)
         metrics.update(self.chunk_metrics(state, hyper, per_iteration))
         params, losses_finite = self.watched(state, per_iteration)
         metrics["finite"] = params_finite(params) & jnp.all(losses_finite)

@@ -57,6 +57,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--env-options", default="", metavar="KEY=VALUE,...",
                    help="change our task's fields from the run's for its side of the comparison (e.g. table=box: "
                    "the reference's table, whose edges a pushed cube can fall off)")  # fmt: skip
+    p.add_argument("--eval-subgoal-reach", type=float, default=None, metavar="M",
+                   help="steer the policy at subgoals at most M from the achieved goal in both simulators, 0 not "
+                   "at all (default: as the run's evaluations did, its eval_subgoal_reach)")  # fmt: skip
     p.add_argument("--out", default=None, metavar="FILE.json",
                    help="default: RUN_DIR/reference.json (with --scripted: scripted-TASK.json)")  # fmt: skip
     p.add_argument("--traces", default=None, metavar="FILE.npz",
@@ -106,14 +109,14 @@ def main(argv: list[str] | None = None) -> int:
             title = f"the scripted {a.scripted} controller, the same {a.episodes} starts in each"
         else:
             import_reference()  # a missing extra fails before the checkpoint is read
-            loaded = load_run(a.run_dir, a.step, a.env_options)
+            loaded = load_run(a.run_dir, a.step, a.env_options, a.eval_subgoal_reach)
             result = evaluate(a.run_dir, a.episodes, a.seed, loaded=loaded)
             what = f"{result['algo']} on {result['task']}, iteration {result['step']}"
             title = f"{a.run_dir} ({what}), {a.episodes} episodes each"
             if a.traces:
-                cfg, env, trainer, pstate, _ = loaded
-                pol = lambda o, g: trainer.policy.act(pstate, o, g)  # noqa: E731
-                tr = traces(env, cfg.env, pol, policy_act(trainer, pstate), a.episodes, a.seed)
+                cfg, env, policy, pstate, _ = loaded
+                pol = lambda o, g: policy.act(pstate, o, g)  # noqa: E731
+                tr = traces(env, cfg.env, pol, policy_act(policy, pstate), a.episodes, a.seed)
     except (EvaluationError, InvalidConfig, CheckpointError) as err:
         print(f"{p.prog}: error: {err}", file=sys.stderr)
         return 2

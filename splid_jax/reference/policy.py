@@ -49,11 +49,14 @@ def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
     return env, trainer, jax.tree.map(lambda x: x[index], state), step
 
 
-def load_run(run_dir: str, step: int | None = None, env_options: str = ""):
-    """(config, our task, algorithm, the policy's ``PolicyState``, step) of the run in ``run_dir``: a
-    run of train, or a member of a sweep. ``env_options`` (``KEY=VALUE,...``) change our task's fields
-    from the run's, e.g. ``table=box`` to put the reference's table edges in our task."""
+def load_run(run_dir: str, step: int | None = None, env_options: str = "", subgoal_reach: float | None = None):
+    """(config, our task, the policy as the run's evaluations acted (``act(pstate, obs, goal)``, steered at
+    subgoals where the run's ``eval_subgoal_reach`` says), its ``PolicyState``, step) of the run in ``run_dir``:
+    a run of train, or a member of a sweep. ``env_options`` (``KEY=VALUE,...``) change our task's fields
+    from the run's, e.g. ``table=box`` to put the reference's table edges in our task; ``subgoal_reach``
+    replaces the run's ``eval_subgoal_reach``."""
     from splid_jax.common.networks import PolicyState
+    from splid_jax.common.subgoals import steered
     from splid_jax.rollout import load_config, load_policy
     from splid_jax.runtime import checkpoint
 
@@ -62,6 +65,8 @@ def load_run(run_dir: str, step: int | None = None, env_options: str = ""):
     cfg = load_config(run_dir)
     if env_options:
         cfg = dataclasses.replace(cfg, env_options=",".join(filter(None, (cfg.env_options, env_options))))
+    if subgoal_reach is not None:
+        cfg = dataclasses.replace(cfg, eval_subgoal_reach=subgoal_reach)
     reference_id(cfg.env)
     sweep = sweep_member(run_dir) if checkpoint.latest_step(run_dir) is None else None
     if checkpoint.latest_step(run_dir) is None and (sweep is None or checkpoint.latest_step(sweep[0]) is None):
@@ -74,14 +79,14 @@ def load_run(run_dir: str, step: int | None = None, env_options: str = ""):
     pstate = getattr(state, "policy", None)
     if not isinstance(pstate, PolicyState):
         raise EvaluationError(f"the checkpoint of {run_dir} holds no policy (no networks.PolicyState at .policy)")
-    return cfg, env, trainer, pstate, step
+    return cfg, env, steered(trainer.policy, env, cfg.eval_subgoal_reach), pstate, step
 
 
-def policy_act(trainer, pstate):
+def policy_act(policy, pstate):
     """The deterministic policy as ``act(obs, goal) -> action``, jitted, batched over leading axes."""
     import jax
 
-    return jax.jit(lambda o, g: trainer.policy.act(pstate, o, g))
+    return jax.jit(lambda o, g: policy.act(pstate, o, g))
 
 
 def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None = None, env_options: str = "",
@@ -94,12 +99,12 @@ def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None 
     from splid_jax.rollout import rollout
 
     import_reference()  # a missing extra fails before any work
-    cfg, env, trainer, pstate, step = loaded or load_run(run_dir, step, env_options)
-    states = jax.jit(lambda ps, k: rollout(env, trainer, ps, k, episodes))(pstate, jax.random.PRNGKey(seed))
+    cfg, env, policy, pstate, step = loaded or load_run(run_dir, step, env_options)
+    states = jax.jit(lambda ps, k: rollout(env, policy, ps, k, episodes))(pstate, jax.random.PRNGKey(seed))
     succ = np.asarray(states.success[1:] & ~states.invalid[1:])
     dist = np.linalg.norm(np.asarray(states.achieved_goal[-1] - states.desired_goal[-1]), axis=-1)
     ours = summarise(succ.any(axis=0), succ[-1], dist)
-    ref = run_reference(cfg.env, policy_act(trainer, pstate), episodes, seed).summary()
+    ref = run_reference(cfg.env, policy_act(policy, pstate), episodes, seed).summary()
     return {
         "run_dir": run_dir,
         "algo": cfg.algo,
@@ -108,6 +113,7 @@ def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None 
         "step": int(step),
         "seed": seed,
         "env_options": cfg.env_options,
+        "eval_subgoal_reach": cfg.eval_subgoal_reach,
         "ours": ours,
         "fetch": ref,
     }

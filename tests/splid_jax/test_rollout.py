@@ -220,7 +220,7 @@ def test_rollout_acts_as_the_evaluation_of_a_her_or_es_run(tmp_path, capsys, alg
 
     _, loaded, pstate, step = rollout.load_policy(rollout.load_config(str(run_dir)))
     assert step == 0 and type(loaded).__name__ == algo.upper()
-    states = rollout.rollout(env, loaded, pstate.policy, jax.random.PRNGKey(3), 16)
+    states = rollout.rollout(env, loaded.policy, pstate.policy, jax.random.PRNGKey(3), 16)
     evaluated = evaluate(env, algo_.policy, state.policy, jax.random.PRNGKey(3), 16)
     succ = np.asarray(states.success[1:] & ~states.invalid[1:])
     assert succ.any(axis=0).mean() == pytest.approx(float(evaluated["eval_success"]))

@@ -36,13 +36,7 @@ def test_rollout_and_the_reference_starts_reset_the_standard_task():
 
     env = _TrainingOnlyStarts()
     policy = make_policy(env.obs_size, env.goal_size, env.action_size, (8,), normalise=False)
-
-    class Trainer:  # what rollout reads of a learner
-        pass
-
-    trainer = Trainer()
-    trainer.policy = policy
-    states = rollout(env, trainer, policy.init(jax.random.PRNGKey(0)), jax.random.PRNGKey(1), 4)
+    states = rollout(env, policy, policy.init(jax.random.PRNGKey(0)), jax.random.PRNGKey(1), 4)
     assert states.obs.shape[:2] == (env.episode_length + 1, 4)
     grasping = envs.make("pick_and_place", grasped_starts=1.0)
     start = our_starts(grasping, jax.random.PRNGKey(1), 8)["state"]
