@@ -77,3 +77,19 @@ def test_exploration_noise_falls_linearly_to_its_end_fraction_and_stays():
     assert float(metrics["sigma"]) == pytest.approx(2.0 * (1 - 0.75 * 0.9))  # the last one's: iteration 9
     constant = Trainer(envs.make("point"), TrainConfig(**CFG))
     assert float(constant.sigma_at(jnp.int32(30), constant.hyper())) == 1.0
+
+
+def test_subgoals_change_the_evaluation_and_nothing_the_training_does(trainer):
+    env = trainer.env
+    steering = Trainer(env, TrainConfig(**CFG, eval_subgoal_reach=env.success_distance))
+    key = jax.random.PRNGKey(3)
+    plain_state, plain = trainer.jitted(trainer.init(key), trainer.hyper())
+    steered_state, steered = jax.jit(steering.chunk)(steering.init(key), steering.hyper())
+    # explore, SELECT and BC alike: to float rounding (two programs, fused apart), integers and keys exactly
+    for a, b in zip(jax.tree_util.tree_leaves(plain_state), jax.tree_util.tree_leaves(steered_state), strict=True):
+        a, b = np.asarray(a), np.asarray(b)
+        if np.issubdtype(a.dtype, np.floating):
+            np.testing.assert_allclose(a, b, rtol=1e-4, atol=1e-6)
+        else:
+            np.testing.assert_array_equal(a, b)
+    assert float(plain["eval_return"]) != float(steered["eval_return"])
