@@ -25,6 +25,7 @@ import numpy as np
 
 import envs
 from envs.base import step_batch
+from splid_jax.common.subgoals import steered
 from splid_jax.common.values import parse_overrides, typed_fields
 from splid_jax.config import TrainConfig
 from splid_jax.learners.her.config import HerConfig
@@ -42,11 +43,12 @@ def share(x, where):
 def traces(env, trainer: Trainer, pstate, key, episodes: int) -> dict:
     """Per-step distance to the goal and success of the deterministic policy, and the achieved goal's
     speed (m/s) on the step of its first hit; from the task's standard starts."""
+    policy = steered(trainer.policy, env, trainer.cfg.eval_subgoal_reach)  # as the run's evaluations act
     env = env.evaluation_task()
     start = jax.vmap(env.reset)(jax.random.split(key, episodes))
 
     def one(state, _):
-        nxt = step_batch(env, state, trainer.policy.act(pstate, state.obs, state.desired_goal))
+        nxt = step_batch(env, state, policy.act(pstate, state.obs, state.desired_goal))
         dist = jnp.linalg.norm(nxt.achieved_goal - nxt.desired_goal, axis=-1)
         speed = jnp.linalg.norm(nxt.achieved_goal - state.achieved_goal, axis=-1) / getattr(env, "dt", 1.0)
         return nxt, (dist, nxt.success & ~nxt.invalid, speed)
