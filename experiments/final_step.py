@@ -78,6 +78,15 @@ def traces(env, trainer: Trainer, pstate, key, episodes: int) -> dict:
     }
 
 
+def goal_distances(env, buf) -> tuple[jax.Array, jax.Array, jax.Array]:
+    """Each relabel-buffer pair's goal distance from the object (m), whether the pair is filled, and whether
+    its goal is held (already where the object is)."""
+    start = env.achieved_goal_start
+    filled = jnp.arange(buf.obs.shape[0]) < buf.size
+    dist = jnp.linalg.norm(buf.goal - buf.obs[:, start : start + env.goal_size], axis=-1)
+    return dist, filled, dist < env.success_distance
+
+
 def buffer_make_up(env, buf) -> dict:
     """What the relabel buffer holds at the end of training, for object tasks: the share of pairs whose
     goal is where the object already is (held goals), whose goal is lifted above the object's resting
@@ -86,10 +95,8 @@ def buffer_make_up(env, buf) -> dict:
     if not getattr(env, "has_object", False):  # the Fetch tasks with an object, whose layout has its height
         return {}
     rest_z, start = env.layout.object_rest_z, env.achieved_goal_start
-    filled = jnp.arange(buf.obs.shape[0]) < buf.size
     obj = buf.obs[:, start : start + 3]
-    dist = jnp.linalg.norm(buf.goal - obj, axis=-1)
-    held = dist < env.success_distance
+    dist, filled, held = goal_distances(env, buf)
     moved = filled & ~held
     return {
         "pairs": buf.size,

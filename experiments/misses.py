@@ -27,15 +27,15 @@ from splid_jax.rollout import rollout
 def trained_goal_reach(run_dir: str, quantile: float) -> float:
     """The ``quantile`` of the distances from the object to the goals of the relabel buffer's pairs whose
     goal is not already held: how far the goals the policy was taught lie."""
+    from final_step import goal_distances
+
     from splid_jax.reference.policy import _restore_member, sweep_member
     from splid_jax.rollout import load_config, load_policy
 
     cfg, sweep = load_config(run_dir), sweep_member(run_dir)
     env, _, state, _ = _restore_member(cfg, sweep, None) if sweep else load_policy(cfg)
-    n, start = int(state.buffer.size), env.achieved_goal_start
-    obs, goal = np.asarray(state.buffer.obs[:n]), np.asarray(state.buffer.goal[:n])
-    dist = np.linalg.norm(goal - obs[:, start : start + 3], axis=-1)
-    return float(np.quantile(dist[dist >= env.success_distance], quantile))
+    dist, filled, held = map(np.asarray, goal_distances(env, state.buffer))
+    return float(np.quantile(dist[filled & ~held], quantile))
 
 
 MOVED = 0.01  # m: an object displaced less than this was never pushed
