@@ -128,11 +128,12 @@ def test_pick_and_place_trains_from_grasped_starts_unless_told_otherwise():
     assert TrainConfig(env="push").env_options == ""
 
 
-def test_push_evaluates_with_subgoals_and_runs_recorded_before_them_read_back_without():
+def test_push_and_pick_and_place_evaluate_with_subgoals_and_runs_recorded_before_them_read_back_without():
     from splid_jax.runtime.run_files import identity
 
     assert TrainConfig(env="push").eval_subgoal_reach == 0.1
     assert TrainConfig(env="push", algo="her").eval_subgoal_reach == 0.1  # one controller for every learner
+    assert TrainConfig(env="pick_and_place").eval_subgoal_reach == 0.1
     assert TrainConfig(env="slide").eval_subgoal_reach == TrainConfig(env="point").eval_subgoal_reach == 0.0
     before = {k: v for k, v in TrainConfig(env="push").to_json().items() if k != "eval_subgoal_reach"}
     assert TrainConfig.from_json(before).eval_subgoal_reach == 0.0  # evaluated as it was
