@@ -88,6 +88,13 @@ class TrainConfig:
         "enough for the arm's noise to lift the object",
         recorded_when_set=True,
     )
+    explore_subgoal_reach: float = field(
+        0.0,
+        "splid, gcsl, pchid: exploration acts towards a subgoal on the line to the goal at most this far from the "
+        "achieved goal (m on the Fetch tasks), as evaluations do with eval_subgoal_reach; relabelling and SELECT "
+        "are unchanged. 0: the goal itself",
+        recorded_when_set=True,
+    )
     hold_horizon: int = field(
         0,
         "hold, settle, stop: steps over which a held-goal candidate is judged (its goal is the object's place "

@@ -44,7 +44,16 @@ _TRAINER = "splid_jax.learners.splid.trainer:Trainer"
 _IMITATION = dict(
     settings=ImitationConfig,
     splits_envs=True,
-    sweeps=("sigma", "horizon", "horizon_end", "sigma_end", "learning_rate", "policy_ema", "gripper_hold"),
+    sweeps=(
+        "sigma",
+        "horizon",
+        "horizon_end",
+        "sigma_end",
+        "learning_rate",
+        "policy_ema",
+        "gripper_hold",
+        "explore_subgoal_reach",
+    ),
 )
 # HER on the Fetch tasks runs as OpenAI Baselines: a cycle explores 2 episodes on each of 8 workers
 # (num_envs 16, with HerConfig's batch of 2048 = 8 x 256 averaged gradients) and an epoch of 50 cycles

@@ -141,3 +141,17 @@ def test_push_and_pick_and_place_evaluate_with_subgoals_and_runs_recorded_before
     assert identity(TrainConfig(env="push"))["eval_subgoal_reach"] == 0.1
     with pytest.raises(InvalidConfig, match="eval_subgoal_reach"):
         TrainConfig(env="push", eval_subgoal_reach=-0.1)
+
+
+def test_exploration_steers_only_when_asked_and_only_for_the_cloning_learners():
+    from splid_jax.runtime.run_files import identity
+
+    assert TrainConfig(env="push").explore_subgoal_reach == 0.0
+    before = {k: v for k, v in TrainConfig(env="push").to_json().items() if k != "explore_subgoal_reach"}
+    assert "explore_subgoal_reach" not in identity(TrainConfig.from_json(before))  # older runs resume as they ran
+    assert identity(TrainConfig(env="push", explore_subgoal_reach=0.1))["explore_subgoal_reach"] == 0.1
+    with pytest.raises(InvalidConfig, match="explore_subgoal_reach"):
+        TrainConfig(env="push", explore_subgoal_reach=-0.1)
+    from splid_jax.learners import registry
+
+    assert [registry.reads(a, "explore_subgoal_reach") for a in registry.names()] == [True, True, True, False, False]

@@ -28,6 +28,7 @@ class ImitationConfig:
     horizon: int
     horizon_end: int
     gripper_hold: int
+    explore_subgoal_reach: float
     hold_horizon: int
     rest_horizon: int
     select: bool
@@ -60,6 +61,8 @@ class ImitationConfig:
             self.horizon_end,
             f"an integer in [0, {self.horizon}] (0: H throughout; at most H)",
         )
+        reach = self.explore_subgoal_reach
+        check(reach >= 0, "explore_subgoal_reach", reach, "a distance >= 0 (0: no subgoals)")
         check(self.gripper_hold >= 1, "gripper_hold", self.gripper_hold, "an integer >= 1 (1: noise drawn every step)")
         check(
             0 <= self.hold_horizon <= self.horizon,

@@ -10,6 +10,7 @@ import jax.numpy as jnp
 
 from envs.base import GoalEnv, State, step_batch
 from splid_jax.common.networks import Policy, PolicyState
+from splid_jax.common.subgoals import subgoal
 
 
 class Trajectory(NamedTuple):
@@ -53,13 +54,22 @@ def hold_fingers(noise: jax.Array, hold: jax.Array) -> jax.Array:
 
 
 def rollout(
-    env: GoalEnv, policy: Policy, pstate: PolicyState, reset_keys: jax.Array, noise: jax.Array, sigma: jax.Array
+    env: GoalEnv,
+    policy: Policy,
+    pstate: PolicyState,
+    reset_keys: jax.Array,
+    noise: jax.Array,
+    sigma: jax.Array,
+    reach: jax.Array | float = jnp.inf,
 ) -> Trajectory:
-    """One episode in each of the envs ``reset_keys`` starts, acting ``policy.mean + sigma * noise``."""
+    """One episode in each of the envs ``reset_keys`` starts, acting ``policy.mean + sigma * noise`` towards
+    the goal, or towards its subgoal within ``reach`` of the achieved goal (``common.subgoals``); the
+    trajectory keeps the task's goal."""
     start = jax.vmap(env.reset)(reset_keys)
 
     def one_step(state: State, eps: jax.Array):
-        action = jnp.clip(policy.mean(pstate, state.obs, state.desired_goal) + sigma * eps, -1.0, 1.0)
+        goal = subgoal(state.achieved_goal, state.desired_goal, reach)
+        action = jnp.clip(policy.mean(pstate, state.obs, goal) + sigma * eps, -1.0, 1.0)
         nxt = step_batch(env, state, action)
         return nxt, (state, action, nxt.achieved_goal, nxt.invalid)
 

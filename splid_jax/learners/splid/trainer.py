@@ -47,6 +47,7 @@ class Hyper:
     learning_rate: jax.Array  # [] float32
     acting_step: jax.Array  # [] float32: 1 - policy_ema, taken in double as a constant's would be
     gripper_hold: jax.Array  # [] int32, steps the fingers' noise is held (tasks that move them)
+    explore_reach: jax.Array  # [] float32, exploration's subgoal reach (inf: the goal itself)
 
 
 class Trainer(Chunked):
@@ -95,6 +96,7 @@ class Trainer(Chunked):
             learning_rate=jnp.float32(bc.learning_rate),
             acting_step=jnp.float32(1.0 - bc.policy_ema),
             gripper_hold=jnp.int32(bc.gripper_hold),
+            explore_reach=jnp.float32(bc.explore_subgoal_reach or jnp.inf),
         )
 
     def init(self, key: jax.Array) -> TrainState:
@@ -129,7 +131,7 @@ class Trainer(Chunked):
             noise = hold_fingers(noise, hyper.gripper_hold)
         horizon = self.horizon_at(ts.iteration, hyper)
         sigma = self.sigma_at(ts.iteration, hyper)
-        seen, cands = self.explore_and_select(ts.policy, reset_keys, noise, sigma, horizon)
+        seen, cands = self.explore_and_select(ts.policy, reset_keys, noise, sigma, horizon, hyper.explore_reach)
         if self.learner.clones_every_pair:
             cands = gcsl.relabel(env, seen, bc.gcsl_relabel, k_relabel)
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
@@ -149,11 +151,13 @@ class Trainer(Chunked):
         )
         return new, metrics
 
-    def explore_and_select(self, pstate, reset_keys, noise, sigma, horizon) -> tuple[Seen, Candidates | None]:
+    def explore_and_select(
+        self, pstate, reset_keys, noise, sigma, horizon, reach=jnp.inf
+    ) -> tuple[Seen, Candidates | None]:
         """Explore the envs and, but for GCSL, SELECT among their relabelled pairs: all of them, or,
         inside the mesh's ``shard_map``, this device's slice, gathered back in the one-device layout."""
         if self.mesh is None:
-            return self._explore_and_select(pstate, reset_keys, noise, sigma, horizon)
+            return self._explore_and_select(pstate, reset_keys, noise, sigma, horizon, reach)
         n = self.cfg.num_envs // self.mesh.size
         first = jax.lax.axis_index(ENVS) * n
         seen, cands = self._explore_and_select(
@@ -162,6 +166,7 @@ class Trainer(Chunked):
             jax.lax.dynamic_slice_in_dim(noise, first, n, axis=1),
             sigma,
             horizon,
+            reach,
         )
         gather = lambda x: jax.lax.all_gather(x, ENVS, axis=1, tiled=True)  # noqa: E731  [T, n] -> [T, N]
         seen = jax.tree.map(gather, seen)
@@ -171,8 +176,8 @@ class Trainer(Chunked):
         whole = [gather(x.reshape((-1, n) + x.shape[1:])).reshape((-1,) + x.shape[1:]) for x in cands[:-1]]
         return seen, Candidates(*whole, jax.lax.psum(cands.replay_steps, ENVS))
 
-    def _explore_and_select(self, pstate, reset_keys, noise, sigma, horizon) -> tuple[Seen, Candidates | None]:
-        traj = rollout(self.env, self.policy, pstate, reset_keys, noise, sigma)
+    def _explore_and_select(self, pstate, reset_keys, noise, sigma, horizon, reach) -> tuple[Seen, Candidates | None]:
+        traj = rollout(self.env, self.policy, pstate, reset_keys, noise, sigma, reach)
         if self.learner.clones_every_pair:
             return traj.seen(), None
         return traj.seen(), self.select(pstate, traj, horizon)

@@ -79,6 +79,17 @@ def test_exploration_noise_falls_linearly_to_its_end_fraction_and_stays():
     assert float(constant.sigma_at(jnp.int32(30), constant.hyper())) == 1.0
 
 
+def test_steered_exploration_is_a_traced_setting_that_changes_what_is_explored(trainer):
+    key = jax.random.PRNGKey(5)
+    assert float(trainer.hyper().explore_reach) == np.inf  # 0: the goal itself
+    steering = trainer.hyper(TrainConfig(**CFG, explore_subgoal_reach=trainer.env.success_distance))
+    plain, _ = trainer.jitted(trainer.init(key), trainer.hyper())
+    steered, _ = trainer.jitted(trainer.init(key), steering)
+    assert trainer.traces == 1  # one program for both: a sweep's members may differ in it
+    filled = int(plain.buffer.size)
+    assert filled > 0 and not np.allclose(plain.buffer.action[:filled], steered.buffer.action[:filled])
+
+
 def test_subgoals_change_the_evaluation_and_nothing_the_training_does(trainer):
     env = trainer.env
     steering = Trainer(env, TrainConfig(**CFG, eval_subgoal_reach=env.success_distance))
