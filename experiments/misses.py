@@ -12,6 +12,7 @@ Writes ``misses.json`` (the counts, and the medians of the start's geometry per 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 
@@ -129,7 +130,9 @@ def main(argv: list[str] | None = None) -> int:
         if a.reference:
             from splid_jax.reference.policy import evaluate
 
-            both = evaluate(run_dir, a.reference, a.seed, loaded=(cfg, env, steered(policy, env, reach), pstate, step))
+            acted = dataclasses.replace(cfg, eval_subgoal_reach=reach)  # the JSON records the reach it acted with
+            loaded = (acted, env, steered(policy, env, reach), pstate, step)
+            both = evaluate(run_dir, a.reference, a.seed, loaded=loaded)
             compared.append(both)
             sides = (f"{s} {both[s]['success_any']:.3f} / {both[s]['success_final']:.3f}" for s in ("ours", "fetch"))
             print(f"{run_dir}: " + ", ".join(sides))
