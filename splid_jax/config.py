@@ -156,7 +156,8 @@ class TrainConfig:
         None,
         "evaluations (and splid_jax.evaluate, splid_jax.rollout) give the policy a subgoal on the line to the goal, "
         "at most this far from the achieved goal (m on the Fetch tasks), and the goal once within it: far goals lie "
-        "beyond those it was taught; success is judged at the goal. 0: the goal itself. Exploration never steers",
+        "beyond those it was taught; success is judged at the goal. 0: the goal itself. Exploration steers only with "
+        "explore_subgoal_reach",
         recorded_when_set=True,
         unrecorded=0.0,
     )
