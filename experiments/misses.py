@@ -181,7 +181,7 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-DISTANCE_BINS = (0.0, 0.1, 0.2, 0.3, 0.45)  # m from the object's start to the goal
+DISTANCE_BINS = (0.0, 0.1, 0.2, 0.3, 0.45, 0.6, 0.9)  # m from the object's start to the goal (Slide's: to 0.85)
 # The push's heading in degrees: 0 away from the robot (+x), 180 towards it (the gripper must go round the object)
 DIRECTION_BINS = (-180.0, -135.0, -45.0, 45.0, 135.0, 180.0)
 
