@@ -21,7 +21,8 @@ def subgoal(achieved: jax.Array, goal: jax.Array, reach: float) -> jax.Array:
     """``goal`` where it lies within ``reach`` of ``achieved``, else the point at ``reach`` on the line to it."""
     gap = goal - achieved
     far = jnp.linalg.norm(gap, axis=-1, keepdims=True)
-    return jnp.where(far > reach, achieved + gap * (reach / jnp.maximum(far, 1e-12)), goal)
+    step = jnp.minimum(reach, far) / jnp.maximum(far, 1e-12)  # finite at an infinite reach: no NaN to discard
+    return jnp.where(far > reach, achieved + gap * step, goal)
 
 
 @dataclasses.dataclass(frozen=True)

@@ -44,3 +44,10 @@ def test_no_reach_keeps_the_policy_and_a_reach_steers_only_far_goals_in_an_evalu
     jax.tree_util.tree_map(np.testing.assert_array_equal, plain, far)
     near = evaluate(env, steered(policy, env, 1e-3), pstate, key, 16)
     assert float(near["eval_return"]) != float(plain["eval_return"])  # a tiny reach changes the actions
+
+
+def test_an_infinite_reach_is_the_goal_itself_without_a_nan_on_the_way():
+    at = jnp.array([[0.3, -0.2], [1.0, 1.0]])
+    goal = jnp.array([[5.0, 7.0], [1.0, 1.0]])  # far, and already achieved
+    with jax.debug_nans(True):  # exploration's default reach: no branch may make a NaN
+        np.testing.assert_array_equal(subgoal(at, goal, jnp.inf), goal)
