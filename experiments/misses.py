@@ -17,10 +17,9 @@ import json
 import os
 
 import jax
-import jax.numpy as jnp
 import numpy as np
 
-from splid_jax.common.subgoals import Steered, steered
+from splid_jax.common.subgoals import Steered, steered, traced_reach
 from splid_jax.reference.policy import load_run
 from splid_jax.rollout import rollout
 
@@ -125,7 +124,7 @@ def main(argv: list[str] | None = None) -> int:
         if a.subgoal_quantile is not None:
             reach = trained_goal_reach(run_dir, a.subgoal_quantile)
         print(f"{run_dir}: " + (f"subgoals within {reach:.3f} of the object" if reach else "the goal itself"))
-        states = jax.block_until_ready(programs[shared](pstate, jax.random.PRNGKey(a.seed), reach or jnp.inf))
+        states = jax.block_until_ready(programs[shared](pstate, jax.random.PRNGKey(a.seed), traced_reach(reach)))
         rows.append(classify(states, env.success_distance))
         if a.reference:
             from splid_jax.reference.policy import evaluate

@@ -25,6 +25,12 @@ def subgoal(achieved: jax.Array, goal: jax.Array, reach: float) -> jax.Array:
     return jnp.where(far > reach, achieved + gap * step, goal)
 
 
+def traced_reach(reach: float) -> jax.Array:
+    """``reach`` as a value a compiled program takes: 0 (no subgoals) is infinite, where ``subgoal`` gives the
+    goal itself, so one program serves every reach."""
+    return jnp.float32(reach or jnp.inf)
+
+
 @dataclasses.dataclass(frozen=True)
 class Steered:
     """``policy`` acting towards ``subgoal``s, the achieved goal read off the observation at ``achieved_slice``."""

@@ -13,6 +13,7 @@ from jax.sharding import PartitionSpec as P
 from envs.base import GoalEnv
 from splid_jax.common.errors import check
 from splid_jax.common.networks import PolicyState, make_policy
+from splid_jax.common.subgoals import traced_reach
 from splid_jax.config import TrainConfig
 from splid_jax.learners import gcsl, registry
 from splid_jax.learners.base import Chunked
@@ -96,7 +97,7 @@ class Trainer(Chunked):
             learning_rate=jnp.float32(bc.learning_rate),
             acting_step=jnp.float32(1.0 - bc.policy_ema),
             gripper_hold=jnp.int32(bc.gripper_hold),
-            explore_reach=jnp.float32(bc.explore_subgoal_reach or jnp.inf),
+            explore_reach=traced_reach(bc.explore_subgoal_reach),
         )
 
     def init(self, key: jax.Array) -> TrainState:
@@ -151,9 +152,7 @@ class Trainer(Chunked):
         )
         return new, metrics
 
-    def explore_and_select(
-        self, pstate, reset_keys, noise, sigma, horizon, reach=jnp.inf
-    ) -> tuple[Seen, Candidates | None]:
+    def explore_and_select(self, pstate, reset_keys, noise, sigma, horizon, reach) -> tuple[Seen, Candidates | None]:
         """Explore the envs and, but for GCSL, SELECT among their relabelled pairs: all of them, or,
         inside the mesh's ``shard_map``, this device's slice, gathered back in the one-device layout."""
         if self.mesh is None:
