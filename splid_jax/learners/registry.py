@@ -60,6 +60,8 @@ _IMITATION = dict(
 # is evaluated (eval_every 50). Push's 1,250 cycles are 20,000 episodes; Slide's and PickAndPlace's
 # 3,200 the 51,200 episodes of the SPLID runs there.
 _HER_FETCH = dict(num_envs=16, eval_every=50)
+# Steered exploration was chosen for SPLID; the baselines explore towards the goal, as their papers do
+_UNSTEERED = {"push": {"explore_subgoal_reach": 0.0}, "pick_and_place": {"explore_subgoal_reach": 0.0}}
 
 LEARNERS: dict[str, Learner] = {
     learner.name: learner
@@ -72,6 +74,7 @@ LEARNERS: dict[str, Learner] = {
             reads=(*_CLONING, "gcsl_relabel"),
             **_IMITATION,
             clones_every_pair=True,
+            task_defaults=_UNSTEERED,
         ),
         Learner(
             "pchid",
@@ -80,7 +83,8 @@ LEARNERS: dict[str, Learner] = {
             reads=(*_CLONING, *(f for f in SELECT_FIELDS if f != "horizon_end"), "pchid_every"),  # its own curriculum
             **_IMITATION,
             grows_horizon=True,
-            task_defaults={"push": {"horizon": 8}},  # SPLID's falling horizon on Push is not PCHID's
+            # SPLID's falling horizon on Push is not PCHID's
+            task_defaults={**_UNSTEERED, "push": {**_UNSTEERED["push"], "horizon": 8}},
         ),
         Learner(
             "her",

@@ -143,13 +143,22 @@ def test_push_and_pick_and_place_evaluate_with_subgoals_and_runs_recorded_before
         TrainConfig(env="push", eval_subgoal_reach=-0.1)
 
 
-def test_exploration_steers_only_when_asked_and_only_for_the_cloning_learners():
+def test_splid_explores_steered_on_push_and_pick_and_place_and_the_baselines_towards_the_goal():
     from splid_jax.runtime.run_files import identity
 
-    assert TrainConfig(env="push").explore_subgoal_reach == 0.0
+    assert TrainConfig(env="push").explore_subgoal_reach == 0.1
+    assert TrainConfig(env="pick_and_place", algo="splid", select=False).explore_subgoal_reach == 0.1
+    assert TrainConfig(env="pick_and_place", algo="gcsl").explore_subgoal_reach == 0.0  # baselines as published
+    assert TrainConfig(env="push", algo="pchid").explore_subgoal_reach == 0.0
+    assert TrainConfig(env="push", algo="pchid", explore_subgoal_reach=0.1).explore_subgoal_reach == 0.1
+    assert TrainConfig(env="slide").explore_subgoal_reach == TrainConfig(env="point").explore_subgoal_reach == 0.0
+    assert TrainConfig(env="push", algo="her").explore_subgoal_reach == 0.0  # HER explores with its own noise
+    assert TrainConfig(env="pick_and_place", algo="es").explore_subgoal_reach == 0.0
     before = {k: v for k, v in TrainConfig(env="push").to_json().items() if k != "explore_subgoal_reach"}
-    assert "explore_subgoal_reach" not in identity(TrainConfig.from_json(before))  # older runs resume as they ran
-    assert identity(TrainConfig(env="push", explore_subgoal_reach=0.1))["explore_subgoal_reach"] == 0.1
+    assert TrainConfig.from_json(before).explore_subgoal_reach == 0.0  # older runs explored towards the goal
+    assert "explore_subgoal_reach" not in identity(TrainConfig.from_json(before))  # and resume as they ran
+    assert identity(TrainConfig(env="push"))["explore_subgoal_reach"] == 0.1
+    assert TrainConfig(env="push", explore_subgoal_reach=0.0).explore_subgoal_reach == 0.0  # the goal itself
     with pytest.raises(InvalidConfig, match="explore_subgoal_reach"):
         TrainConfig(env="push", explore_subgoal_reach=-0.1)
     from splid_jax.learners import registry
