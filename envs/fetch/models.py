@@ -214,7 +214,7 @@ def mjcf(
     mocap body at the grip site's target (the tasks' field ``drive``, ``experiments/parity/slide_c.py``);
     ``ctrl[0:3]`` then moves nothing.
 
-    ``finger_table`` > 0 (Reach, Push, PickAndPlace): the fingers reach ``REFERENCE_FINGER_BELOW_SITE``
+    ``finger_table`` > 0: the fingers reach ``REFERENCE_FINGER_BELOW_SITE``
     below the grip site and touch the table with this friction (condim 3), so a gripper driven down at
     the table presses on it and drags, as the reference's does under its mocap weld; 0: no such contact.
 
@@ -235,8 +235,8 @@ def mjcf(
         raise ValueError(f"drive must be one of {DRIVES}, got {drive!r}")
     if finger_drive not in FINGER_DRIVES:
         raise ValueError(f"finger_drive must be one of {FINGER_DRIVES}, got {finger_drive!r}")
-    if finger_table < 0 or (finger_table > 0 and kind == "slide"):
-        raise ValueError(f"finger_table must be >= 0 (0 on slide), got {finger_table}")
+    if finger_table < 0:
+        raise ValueError(f"finger_table must be >= 0, got {finger_table}")
     (tx, ty, tz), (hx, hy, hz), (gx, gy, gz) = _SCENES[kind]
     has_object = kind != "reach"
     free_fingers = kind == "pick_and_place"
@@ -294,14 +294,17 @@ def mjcf(
     <pair geom1="finger_l" geom2="object" condim="4" friction="1 1 0.005 0.0001 0.0001"/>
     <pair geom1="finger_r" geom2="object" condim="4" friction="1 1 0.005 0.0001 0.0001"/>"""
     elif slide:
-        # Closed fingers drawn as a block; they strike the puck with four round corner tips.
+        # Closed fingers drawn as a block; they strike the puck with four round corner tips. With a finger-table
+        # contact the block and the tips reach the reference's fingertips' depth, the tips' bottoms level with
+        # the block's (without it, the tips' centres sit at the grip site, where they were fitted to the strike).
         c, r = SLIDE_TIP_XY, SLIDE_TIP_RADIUS
         tips = [(f"tip_{i}", sx * c, sy * c) for i, (sx, sy) in enumerate([(1, 1), (1, -1), (-1, 1), (-1, -1)])]
+        block_z, tip_z = (finger_z, r - below) if finger_table > 0 else (finger_z + r, 0.0)
         fingers = f"""
-      <geom name="fingers" type="box" size="{_fmt(c, c)} 0.03" pos="0 0 {finger_z + r:.6g}" mass="0.001"
+      <geom name="fingers" type="box" size="{_fmt(c, c)} 0.03" pos="0 0 {block_z:.6g}" mass="0.001"
             {nograv} rgba="0.3 0.3 0.3 1"/>""" + "".join(
             f"""
-      <geom name="{n}" type="sphere" size="{r:.6g}" pos="{_fmt(x, y)} 0" mass="0.001" {nograv}
+      <geom name="{n}" type="sphere" size="{r:.6g}" pos="{_fmt(x, y, tip_z)}" mass="0.001" {nograv}
             rgba="0.3 0.3 0.3 1"/>"""
             for n, x, y in tips
         )

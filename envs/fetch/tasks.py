@@ -158,9 +158,7 @@ class _FetchTask(GoalEnv):
         ok = 0 <= self.grasped_starts <= 1 and (self.grasped_starts == 0 or not self.block_gripper)
         check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
         check(0 <= self.floor_clearance <= 0.1, f"{n}.floor_clearance", self.floor_clearance, "in [0, 0.1] m")
-        table_range = "0 (the puck is struck by fingertips)" if n == "slide" else "in [0, 2]"
-        ok = 0 <= self.finger_table <= 2 and (self.finger_table == 0 or n != "slide")
-        check(ok, f"{n}.finger_table", self.finger_table, table_range)
+        check(0 <= self.finger_table <= 2, f"{n}.finger_table", self.finger_table, "in [0, 2]")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)

@@ -130,7 +130,7 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("slide", "workspace", "sphere"),
         ("push", "drive", "mocap"),
         ("reach", "floor_clearance", -0.01),
-        ("slide", "finger_table", 1.0),  # the puck is struck by fingertips, not the finger block
+        ("slide", "finger_table", 3.0),
         ("push", "finger_table", -1.0),
         ("pick_and_place", "finger_drive", "instant"),
     ],
@@ -295,6 +295,27 @@ def test_drive_options_set_how_fast_the_gripper_follows_and_reject_nonpositive_v
     ):
         with pytest.raises(ValueError, match=field):
             models.mjcf("slide", **{field: bad})
+
+
+def _grip_height_driven_down(xml: str, target_z: float) -> float:
+    """The grip site's height after 0.5 s of its drive pulling it down towards ``target_z`` (MuJoCo C)."""
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    g = m.joint("grip_x").qposadr[0]
+    mujoco.mj_forward(m, d)
+    d.ctrl[0:3] = [d.qpos[g], d.qpos[g + 1], target_z - m.body("gripper").pos[2]]  # joint coordinates
+    for _ in range(int(round(0.5 / m.opt.timestep))):
+        mujoco.mj_step(m, d)
+    return float(d.site("grip").xpos[2])
+
+
+def test_slide_fingers_with_a_table_contact_stop_on_the_table_at_the_reference_fingertips_depth():
+    floor = models.workspace_box("slide", 1.0)[0][2]  # the press below the fingertips-on-the-table height
+    stopped = _grip_height_driven_down(models.mjcf("slide", 0.002, 10, 4, finger_table=1.0), floor)
+    assert abs(stopped - (models.TABLE_TOP + models.REFERENCE_FINGER_BELOW_SITE)) < 0.003, stopped
+    # without the contact nothing meets the table: the gripper goes where its drive sends it
+    glides = _grip_height_driven_down(models.mjcf("slide", 0.002, 10, 4), floor)
+    assert glides < stopped - 0.015, glides
 
 
 def test_weld_drive_pulls_the_gripper_onto_its_mocap_target():
