@@ -1,4 +1,4 @@
-"""Steering a goal-conditioned policy at subgoals: in evaluations, and in exploration when a run asks.
+"""Steering a goal-conditioned policy at subgoals: in evaluations, and in exploration where explore_subgoal_reach says.
 
 A policy taught with hindsight goals a few steps ahead has seen goals only so far from the achieved goal
 (Push's relabel buffer: 90 % within 0.19 m of the cube); a farther goal is an input outside that range,
