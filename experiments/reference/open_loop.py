@@ -55,12 +55,13 @@ def on_top(ep) -> np.ndarray:
 def per_episode(ep) -> dict:
     grip_x = ep.obs[..., 0] - ep.obs[:, :1, 0]
     obj = ep.obs[..., 3:6]
+    top = on_top(ep)
     return {
         "furthest_grip_x": np.max(grip_x, axis=1),  # from the start
         "final_minus_goal_x": obj[:, -1, 0] - ep.goal[:, 0],
         "fell": np.min(obj[..., 2], axis=1) < obj[:, 0, 2] - 0.05,  # 5 cm below where it rested: off the table
-        "on_top_steps": on_top(ep).mean(axis=1),
-        "on_top_last": on_top(ep)[:, -1],
+        "on_top_steps": top.mean(axis=1),
+        "on_top_last": top[:, -1],
         "any": ep.success.any(axis=1),
         "final": ep.success[:, -1],
     }
@@ -72,7 +73,7 @@ def summary(eps: dict) -> dict:
         "final_minus_goal_x_median": float(np.median(eps["final_minus_goal_x"])),
         "fell": int(eps["fell"].sum()),
         "on_top_share_of_steps": float(eps["on_top_steps"].mean()),
-        "final_successes_on_top_at_the_end": int((eps["final"] & (eps["on_top_last"])).sum()),
+        "final_successes_on_top_at_the_end": int((eps["final"] & eps["on_top_last"]).sum()),
         "success_any": float(eps["any"].mean()),
         "success_final": float(eps["final"].mean()),
     }

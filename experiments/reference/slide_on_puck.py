@@ -22,21 +22,18 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", ".."))
 
 from splid_jax.common.values import parse_overrides  # noqa: E402
 from splid_jax.reference.extra import import_reference, make_reference  # noqa: E402
-from splid_jax.reference.mapping import reference_start  # noqa: E402
+from splid_jax.reference.mapping import reference_shift, reference_start  # noqa: E402
 
 ACTIONS = (
     [(0, 0, 1, 0)] * 2 + [(0.6, 0, 0, 0)] * 2 + [(0, 0, -1, 0)] * 6 + [(0.5, 0, -1, 0)] * 8 + [(0.5, 0, -0.3, 0)] * 8
 )
 
 
-def ours(offset: float, env_options: dict) -> np.ndarray:
-    """Observation slots 0:6 (grip xyz, puck xyz) per step in our task, [T + 1, 6]."""
+def ours(env, offset: float) -> np.ndarray:
+    """Observation slots 0:6 (grip xyz, puck xyz) per step in our task ``env``, [T + 1, 6]."""
     import jax
     import jax.numpy as jnp
 
-    import envs
-
-    env = envs.make("slide", **env_options)
     lay = env.layout
     s = env.reset(jax.random.PRNGKey(0))
     o = lay.object_q
@@ -51,12 +48,12 @@ def ours(offset: float, env_options: dict) -> np.ndarray:
     return np.array(out, np.float64)
 
 
-def reference(offset: float, home: np.ndarray) -> np.ndarray:
+def reference(task_env, offset: float) -> np.ndarray:
+    """The same in FetchSlide-v4, the puck put at the same place relative to the grip home."""
     env = make_reference("slide")
     env.reset(seed=0)
-    u = env.unwrapped
-    shift = np.asarray(u.initial_gripper_xpos[:3]) - home
-    obs = reference_start(env, home[:2] + np.array([0.04 + offset, 0.0]) + shift[:2], np.asarray(u.goal))
+    xy = np.asarray(task_env.layout.grip_home[:2]) + np.array([0.04 + offset, 0.0])
+    obs = reference_start(env, xy + reference_shift(task_env, env)[:2], np.asarray(env.unwrapped.goal))
     out = [obs["observation"][:6]]
     for a in ACTIONS:
         obs, *_ = env.step(np.asarray(a, np.float64))
@@ -74,9 +71,8 @@ def main(argv=None) -> int:
     import envs
 
     import_reference()
-    options = parse_overrides(args.env_options)
-    home = np.asarray(envs.make("slide", **options).layout.grip_home, np.float64)
-    sims = {"ours": ours(args.offset, options), "fetch": reference(args.offset, home)}
+    env = envs.make("slide", **parse_overrides(args.env_options))
+    sims = {"ours": ours(env, args.offset), "fetch": reference(env, args.offset)}
     result = {"offset": args.offset, "env_options": args.env_options, "actions": ACTIONS}
     for name, x in sims.items():
         result[name] = {

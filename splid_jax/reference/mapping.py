@@ -26,12 +26,21 @@ def reference_start(env, object_xy: np.ndarray | None, goal: np.ndarray) -> dict
     return u._get_obs()
 
 
+def reference_shift(env, reference_env) -> np.ndarray:
+    """What moves a point of our task ``env`` into the coordinates of the reset ``reference_env``: x-y by the
+    difference of the two grip homes; z by that of the object rest heights (tasks with an object: goals sit on
+    the table or a lift above it) or of the grip homes (Reach)."""
+    u, lay = reference_env.unwrapped, env.layout
+    shift = np.asarray(u.initial_gripper_xpos[:3], np.float64) - np.asarray(lay.grip_home)
+    if env.has_object:
+        shift[2] = float(u.height_offset) - lay.object_rest_z
+    return shift
+
+
 def our_starts(env, key, episodes: int, reference_env=None):
     """Our task's starts (``jax.vmap(env.reset)`` of ``episodes`` keys split from ``key``, as the
     project's evaluation draws them): ``state``, and the object x-y and goal for ``reference_start``.
-    Given a reset reference env, these are moved into its coordinates: x-y by the difference of the two
-    grip homes; z by that of the object rest heights (tasks with an object: goals sit on the table or a
-    lift above it) or of the grip homes (Reach)."""
+    Given a reset reference env, these are moved into its coordinates (``reference_shift``)."""
     import jax
 
     env = env.evaluation_task()  # judged from the standard starts, whatever the run trained from
@@ -39,10 +48,8 @@ def our_starts(env, key, episodes: int, reference_env=None):
     goal = np.asarray(start.desired_goal, np.float64)
     xy = np.asarray(start.achieved_goal[:, :2], np.float64) if env.has_object else None
     if reference_env is not None:
-        u, lay = reference_env.unwrapped, env.layout
-        shift = np.asarray(u.initial_gripper_xpos[:3], np.float64) - np.asarray(lay.grip_home)
+        shift = reference_shift(env, reference_env)
         if env.has_object:
-            shift[2] = float(u.height_offset) - lay.object_rest_z
             xy = xy + shift[:2]
         goal = goal + shift
     return {"state": start, "object_xy": xy, "goal": goal}
