@@ -35,31 +35,39 @@ def _written_out(cond, body, val, trips: int):
     return val
 
 
-def writes_out(choice: str, backend: str) -> bool:
-    """Whether a task's ``solver_loops`` choice writes the solver out on ``backend``: ``auto`` does so on a
-    GPU only, where the loops' host round trips cost (an XLA:CPU loop reads no condition back, and the
-    written-out solver there compiles twice as long and steps slower)."""
-    return choice == "unrolled" or (choice == "auto" and backend == "gpu")
+def writes_out(choice: str, backend: str) -> tuple[bool, bool]:
+    """Which of the solver's loops a task's ``solver_loops`` choice writes out on ``backend``, as (Newton
+    loop, line search). ``search`` writes out the line search alone: the Newton loop's few trips stay a
+    loop, so its body is traced once and the compile grows little. ``gpu-search`` (the Fetch tasks'
+    default) and ``auto`` write out the line search, or both, on a GPU only, where the loops' host
+    round trips cost; an XLA:CPU loop reads no condition back, and the written-out solver there
+    compiles twice as long and steps slower."""
+    gpu = backend == "gpu"
+    newton = choice == "unrolled" or (choice == "auto" and gpu)
+    return newton, newton or choice == "search" or (choice == "gpu-search" and gpu)
 
 
 @contextlib.contextmanager
-def unrolled_in_mjx(iterations: int, enabled: bool = True):
-    """Within the block, MJX's Newton loop runs ``iterations`` written-out trips and its line search
-    ``ls_iterations`` (MJX passes that count); other loops are left as they are."""
-    if not enabled:
+def unrolled_in_mjx(iterations: int, newton: bool = True, line_search: bool = True):
+    """Within the block, MJX's Newton loop runs ``iterations`` written-out trips (``newton``) and its
+    line search ``ls_iterations`` (``line_search``; MJX passes that count); other loops are left as
+    they are."""
+    if not (newton or line_search):
         yield
         return
     with TRACE_LOCK:
-        while_loop, line_search = jax.lax.while_loop, mjx_solver._while_loop_scan
+        while_loop, search_loop = jax.lax.while_loop, mjx_solver._while_loop_scan
 
         def solver_while(cond, body, init):
             if getattr(body, "__module__", None) != _SOLVER_MODULE:
                 return while_loop(cond, body, init)
             return _written_out(cond, body, init, iterations)
 
-        jax.lax.while_loop = solver_while
-        mjx_solver._while_loop_scan = lambda cond, body, init, max_iter: _written_out(cond, body, init, max_iter)
+        if newton:
+            jax.lax.while_loop = solver_while
+        if line_search:
+            mjx_solver._while_loop_scan = lambda cond, body, init, max_iter: _written_out(cond, body, init, max_iter)
         try:
             yield
         finally:
-            jax.lax.while_loop, mjx_solver._while_loop_scan = while_loop, line_search
+            jax.lax.while_loop, mjx_solver._while_loop_scan = while_loop, search_loop

@@ -42,7 +42,8 @@ _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4)
 GOAL_LIFT_MAX = 0.45
 GRASP_ABOVE_SITE = 0.01  # a grasped cube's centre above the grip site: inside the fingers' 6 cm height
 CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
-SOLVER_LOOPS = ("loops", "unrolled", "auto")  # MJX's solver loops, written out, or written out on a GPU only
+# MJX's solver loops, both written out, the line search alone written out, and each of the last two on a GPU only
+SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search")
 
 
 @struct.dataclass
@@ -105,9 +106,9 @@ class _FetchTask(GoalEnv):
     finger: str = experimental("box")
     # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     cholesky: str = experimental("unrolled")
-    # MJX's Newton solver as its loops, written out, or written out on a GPU only (auto; envs/solver_loops.py):
-    # equal to float rounding
-    solver_loops: str = experimental("loops", numerics_only=True)
+    # MJX's Newton solver as its loops, written out (unrolled), its line search alone written out (search),
+    # or either on a GPU only (auto, gpu-search; envs/solver_loops.py): equal to float rounding
+    solver_loops: str = experimental("gpu-search", numerics_only=True)
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
     # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
@@ -334,9 +335,9 @@ class _FetchTask(GoalEnv):
         if self.drive == "weld":  # the constraint pulls the gripper to the mocap body, put at the target
             home = jnp.asarray(self.layout.grip_home, data.mocap_pos.dtype)
             data = data.replace(mocap_pos=data.mocap_pos.at[0].set(home + ctrl[0:3]))
-        written_out = solver_loops.writes_out(self.solver_loops, jax.default_backend())
+        newton, line_search = solver_loops.writes_out(self.solver_loops, jax.default_backend())
         with small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"):
-            with solver_loops.unrolled_in_mjx(self.iterations, written_out):
+            with solver_loops.unrolled_in_mjx(self.iterations, newton, line_search):
                 data = jax.lax.fori_loop(0, self.substeps, lambda _, d: mjx.step(model, d), data)
         return Physics(
             qpos=data.qpos, qvel=data.qvel, ctrl=data.ctrl, time=data.time, qacc_warmstart=data.qacc_warmstart

@@ -1,10 +1,12 @@
-"""The written-out MJX solver: the loops' arithmetic to float rounding, and nothing else swapped."""
+"""The written-out MJX solver (whole, or its line search alone): the loops' arithmetic to float rounding,
+and nothing else swapped."""
 
 from __future__ import annotations
 
 import jax
 import jax.numpy as jnp
 import numpy as np
+import pytest
 
 import envs
 from envs import solver_loops
@@ -30,18 +32,31 @@ def _loop_primitives(**options) -> set[str]:
 
 
 def test_written_out_solver_leaves_no_loop_in_the_step():
-    assert _loop_primitives() == {"while[", "scan["}  # the Newton loop, its line search (and the substeps)
+    assert _loop_primitives(solver_loops="loops") == {"while[", "scan["}  # Newton, its line search, the substeps
     assert _loop_primitives(solver_loops="unrolled") == {"scan["}  # the substeps' loop alone
     assert _loop_primitives(solver_loops="auto") == {"while[", "scan["}  # the loops on the CPU
+    assert _loop_primitives() == {"while[", "scan["}  # the default, gpu-search: the loops on the CPU
 
 
-def test_auto_writes_the_solver_out_on_a_gpu_only():
-    assert [solver_loops.writes_out("auto", b) for b in ("gpu", "cpu", "tpu")] == [True, False, False]
-    assert solver_loops.writes_out("unrolled", "cpu") and not solver_loops.writes_out("loops", "gpu")
+def test_written_out_line_search_keeps_the_newton_loop_alone():
+    env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, solver_loops="search")
+    text = str(jax.make_jaxpr(env.step)(env.reset(jax.random.PRNGKey(0)), jnp.zeros(4)))
+    assert text.count("while[") == 1 and text.count("scan[") == 1  # the Newton loop and the substeps'
 
 
-def test_written_out_solver_follows_the_loops_path():
-    loops, written = _path(), _path(solver_loops="unrolled")
+def test_gpu_choices_write_the_solver_out_on_a_gpu_only():
+    on = [solver_loops.writes_out("auto", b) for b in ("gpu", "cpu", "tpu")]
+    assert on == [(True, True), (False, False), (False, False)]
+    assert solver_loops.writes_out("unrolled", "cpu") == (True, True)
+    assert solver_loops.writes_out("search", "gpu") == (False, True)
+    assert solver_loops.writes_out("loops", "gpu") == (False, False)
+    on = [solver_loops.writes_out("gpu-search", b) for b in ("gpu", "cpu")]
+    assert on == [(False, True), (False, False)]
+
+
+@pytest.mark.parametrize("choice", ["unrolled", "search"])
+def test_written_out_solver_follows_the_loops_path(choice):
+    loops, written = _path(solver_loops="loops"), _path(solver_loops=choice)
     assert np.isfinite(written).all()
     np.testing.assert_allclose(written, loops, atol=1e-5)
 
@@ -58,4 +73,5 @@ def test_only_the_solvers_loops_are_swapped_and_only_inside_the_block():
 def test_settings_record_the_written_out_solver_only_when_chosen():
     # a run recorded before the option existed matches a task at its default
     assert "solver_loops" not in envs.make("push").settings()
+    assert envs.make("push", solver_loops="loops").settings()["solver_loops"] == "loops"
     assert envs.make("push", solver_loops="unrolled").settings()["solver_loops"] == "unrolled"
