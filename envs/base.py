@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import abc
 import dataclasses
+import functools
 from typing import Any
 
 import jax
@@ -125,6 +126,15 @@ def _placed_on_cpu() -> bool:
 
 def step_batch(env: GoalEnv, state: State, action: jax.Array) -> State:
     """``env.step`` over a leading batch axis: one vmap, or on the CPU ``lax.map`` over slices."""
+    step = _traced_once(env)
     if action.shape[0] <= CPU_STEP_SLICE or not _placed_on_cpu():
-        return jax.vmap(env.step)(state, action)
-    return jax.lax.map(lambda sa: env.step(*sa), (state, action), batch_size=CPU_STEP_SLICE)
+        return jax.vmap(step)(state, action)
+    return jax.lax.map(lambda sa: step(*sa), (state, action), batch_size=CPU_STEP_SLICE)
+
+
+@functools.lru_cache(maxsize=64)
+def _traced_once(env: GoalEnv):
+    """``env.step`` as one jitted function per task: exploration, SELECT and evaluation step the same
+    task at different batch sizes, and JAX traces the unbatched step once for all of them instead of
+    once per caller (XLA inlines the call)."""
+    return jax.jit(env.step)
