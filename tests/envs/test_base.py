@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import envs
+import envs.point_fourrooms
 from envs.base import CPU_STEP_SLICE, step_batch
 
 
@@ -50,3 +51,23 @@ def test_the_achieved_goal_sits_where_the_task_says_and_success_ends_at_its_dist
     inside = s.achieved_goal + 0.99 * env.success_distance * direction
     outside = s.achieved_goal + 1.01 * env.success_distance * direction
     assert bool(env.success(s.achieved_goal, inside).all()) and not bool(env.success(s.achieved_goal, outside).any())
+
+
+class _CountedPoint(envs.point_fourrooms.PointFourRooms):
+    """The point task, counting how often JAX traces its step (a Python side effect at trace time)."""
+
+    def step(self, state, action):
+        _TRACES.append(action.shape)
+        return super().step(state, action)
+
+
+_TRACES: list = []
+
+
+def test_each_task_step_is_traced_once_whatever_the_batch_sizes():
+    env = _CountedPoint()
+    equal = _CountedPoint()  # another object, the same task: the same trace
+    for task, n in ((env, 3), (env, 5), (equal, 7)):  # exploration, evaluation, SELECT: their own batch sizes
+        state = jax.vmap(task.reset)(jax.random.split(jax.random.PRNGKey(0), n))
+        jax.make_jaxpr(lambda s, a, task=task: step_batch(task, s, a))(state, jnp.zeros((n, task.action_size)))
+    assert _TRACES == [(env.action_size,)]  # the unbatched step, once
