@@ -329,8 +329,8 @@ class _FetchTask(GoalEnv):
 
         The substeps' loop carries ``Physics`` alone, not MJX's whole ``Data``: every field it carries is
         then batched from the start under ``vmap``, so JAX batches the substep's body once, instead of a
-        second time after finding that ``make_data``'s fields come out batched (a third of tracing a
-        Fetch step). A step reads nothing else of the previous one's ``Data``."""
+        second time after finding that ``make_data``'s fields come out batched (a quarter of the Push
+        chunk's tracing). A step reads nothing else of the previous one's ``Data``."""
         from mujoco import mjx
 
         model = self.mjx_model
