@@ -221,6 +221,7 @@ class _Loop:
         like = _abstract(jax.eval_shape(init, keys), sharding)  # the whole sweep's, as checkpoints hold it
         one = like if groups is None else groups.first(like)  # what one compiled program takes
         hyper = _canonical(hyper, sharding)
+        t0 = time.perf_counter()
         try:
             traced = self.signals.wait(lambda: jax.jit(chunk).trace(one, groups.first(hyper) if groups else hyper))
         except OverflowError as e:  # an index past int32: sizes far beyond any device's memory
@@ -228,6 +229,7 @@ class _Loop:
                 f"invalid sizes ({sizes(cfg, len(self.lanes))}): too large for the program's 32-bit indices, "
                 "and for any device's memory"
             ) from e
+        traced_s = time.perf_counter() - t0
         state_bytes = sum(nbytes(x) for x in jax.tree.leaves(one))
         largest = largest_value(traced.jaxpr.jaxpr)
         what = f"state {gigabytes(state_bytes)} twice, largest intermediate {gigabytes(largest)}"
@@ -246,7 +248,7 @@ class _Loop:
             compiled = groups.compile(compiled, lambda dev: jax.jit(chunk).trace(
                 groups.on(one, dev), groups.on(groups.first(hyper), dev)).lower().compile(), self.signals)  # fmt: skip
             hyper = groups.split(hyper)
-        self.show(f"compiled in {time.perf_counter() - t0:.1f} s")
+        self.show(f"compiled in {time.perf_counter() - t0:.1f} s (traced before it in {traced_s:.1f} s)")
         if analysis is not None:
             need = analysis.argument_size_in_bytes + analysis.output_size_in_bytes + analysis.temp_size_in_bytes
             check_memory(need - analysis.alias_size_in_bytes, "as compiled", self.device, cfg, len(self.lanes))
