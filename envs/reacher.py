@@ -16,7 +16,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs.base import GoalEnv, State, flag_invalid
+from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
 from splid_jax.common.errors import check, check_integer
 
 LINKS = (0.1, 0.11)  # shoulder to elbow, elbow to fingertip (Gym's fingertip body sits at 0.11)
@@ -138,12 +138,8 @@ class Reacher(GoalEnv):
         from mujoco import mjx
 
         model = self.mjx_model
-        phys = state.physics
-        data = mjx.make_data(model).replace(
-            qpos=phys.qpos, qvel=phys.qvel, qacc_warmstart=phys.qacc_warmstart, ctrl=jnp.clip(action, -1.0, 1.0)
-        )
-        data = jax.lax.fori_loop(0, self.frame_skip, lambda _, d: mjx.step(model, d), data)
-        phys = Physics(qpos=data.qpos, qvel=data.qvel, qacc_warmstart=data.qacc_warmstart)
+        data = mjx.make_data(model).replace(ctrl=jnp.clip(action, -1.0, 1.0))
+        phys = mjx_substeps(model, data, state.physics, self.frame_skip)
         return flag_invalid(self._state(phys, state.desired_goal, state.step + 1, state.invalid))
 
     def with_goal(self, state: State, goal: jax.Array) -> State:

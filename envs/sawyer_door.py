@@ -32,7 +32,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs.base import GoalEnv, State, flag_invalid
+from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
 from splid_jax.common.errors import check, check_integer
 
 GOAL_MAX = 0.83  # the largest goal angle (GCSL's multiworld settings), rad
@@ -210,11 +210,7 @@ class SawyerDoor(GoalEnv):
         phys = state.physics
         lo, hi = (jnp.asarray(b) for b in WORKSPACE)
         target = jnp.clip(phys.qpos[1:4] + self.action_scale * jnp.clip(action, -1.0, 1.0), lo, hi)
-        data = mjx.make_data(model).replace(
-            qpos=phys.qpos, qvel=phys.qvel, qacc_warmstart=phys.qacc_warmstart, ctrl=target
-        )
-        data = jax.lax.fori_loop(0, self.frame_skip, lambda _, d: mjx.step(model, d), data)
-        phys = Physics(qpos=data.qpos, qvel=data.qvel, qacc_warmstart=data.qacc_warmstart)
+        phys = mjx_substeps(model, mjx.make_data(model).replace(ctrl=target), phys, self.frame_skip)
         return flag_invalid(self._state(phys, state.desired_goal, state.step + 1, state.invalid))
 
     def with_goal(self, state: State, goal: jax.Array) -> State:

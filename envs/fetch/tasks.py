@@ -33,7 +33,7 @@ import jax.numpy as jnp
 from flax import struct
 
 from envs import small_cholesky, solver_loops
-from envs.base import GoalEnv, State, flag_invalid
+from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
 from envs.fetch import models
 from splid_jax.common.errors import check, check_integer
 
@@ -325,12 +325,7 @@ class _FetchTask(GoalEnv):
         return ctrl
 
     def simulate(self, phys: Physics, ctrl: jax.Array) -> Physics:
-        """``substeps`` MJX steps from ``phys`` with control ``ctrl``.
-
-        The substeps' loop carries ``Physics`` alone, not MJX's whole ``Data``: every field it carries is
-        then batched from the start under ``vmap``, so JAX batches the substep's body once, instead of a
-        second time after finding that ``make_data``'s fields come out batched (a quarter of the Push
-        chunk's tracing). A step reads nothing else of the previous one's ``Data``."""
+        """``substeps`` MJX steps from ``phys`` with control ``ctrl``."""
         from mujoco import mjx
 
         model = self.mjx_model
@@ -338,16 +333,10 @@ class _FetchTask(GoalEnv):
         if self.drive == "weld":  # the constraint pulls the gripper to the mocap body, put at the target
             home = jnp.asarray(self.layout.grip_home, data.mocap_pos.dtype)
             data = data.replace(mocap_pos=data.mocap_pos.at[0].set(home + ctrl[0:3]))
-
-        def substep(_, p: Physics) -> Physics:
-            d = data.replace(qpos=p.qpos, qvel=p.qvel, ctrl=p.ctrl, time=p.time, qacc_warmstart=p.qacc_warmstart)
-            d = mjx.step(model, d)
-            return Physics(qpos=d.qpos, qvel=d.qvel, ctrl=d.ctrl, time=d.time, qacc_warmstart=d.qacc_warmstart)
-
         newton, line_search = solver_loops.writes_out(self.solver_loops, jax.default_backend())
         with small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"):
             with solver_loops.unrolled_in_mjx(self.iterations, newton, line_search):
-                return jax.lax.fori_loop(0, self.substeps, substep, phys.replace(ctrl=ctrl))
+                return mjx_substeps(model, data, phys.replace(ctrl=ctrl), self.substeps)
 
     def step(self, state: State, action: jax.Array) -> State:
         action = jnp.clip(action, -1.0, 1.0)
