@@ -55,6 +55,30 @@ def pytest_unconfigure(config):
     shutil.rmtree(config.splid_cache_home, ignore_errors=True)
 
 
+# Test files that step the same compiled programs (``FetchEpisodes``'s Push program below): one xdist
+# work unit, so they run on one worker and the program compiles once (about 20 s each time it doesn't).
+SHARED_PROGRAMS = {
+    "tests/envs/test_fetch_tasks.py": "fetch-episodes",
+    "tests/envs/test_small_cholesky.py": "fetch-episodes",
+    "tests/splid_jax/learners/splid/test_select_mjx.py": "fetch-episodes",
+}
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadfile`` with the files of ``SHARED_PROGRAMS`` grouped into one unit each."""
+    if config.getoption("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class SharedProgramScheduling(LoadFileScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            path = super()._split_scope(nodeid)
+            return SHARED_PROGRAMS.get(path, path)
+
+    return SharedProgramScheduling(config, log)
+
+
 def _primitives(jaxpr) -> set[str]:
     names = set()
     for eqn in jaxpr.eqns:
