@@ -6,6 +6,7 @@ program (``FetchEpisodes``) that every test stepping that task reuses, at one ba
 
 from __future__ import annotations
 
+import collections
 import functools
 import os
 import shutil
@@ -62,16 +63,53 @@ SHARED_PROGRAMS = {
     "tests/envs/test_small_cholesky.py": "fetch-episodes",
     "tests/splid_jax/learners/splid/test_select_mjx.py": "fetch-episodes",
 }
+# The longest units' seconds on a 2-core CPU (a full run's --durations, summed per unit). They go out
+# first, longest first, so the last units handed out are short and the two workers end together (in
+# the order of collection, a worker once sat idle for the last 90 s). Only the order depends on these.
+UNIT_SECONDS = {
+    "fetch-episodes": 190,
+    "tests/splid_jax/test_train.py": 100,
+    "tests/envs/test_solver_loops.py": 55,
+    "tests/splid_jax/reference/test_cli.py": 48,
+    "tests/splid_jax/learners/test_algos.py": 45,
+    "tests/splid_jax/runtime/test_devices.py": 40,
+    "tests/splid_jax/learners/her/test_her.py": 40,
+    "tests/splid_jax/runtime/test_multihost.py": 37,
+    "tests/splid_jax/test_rollout.py": 36,
+    "tests/splid_jax/test_sweep.py": 31,
+    "tests/splid_jax/learners/splid/test_trainer.py": 29,
+    "tests/envs/test_reacher.py": 29,
+    "tests/splid_jax/test_figures.py": 22,
+    "tests/splid_jax/learners/test_gcsl.py": 15,
+    "tests/envs/test_base.py": 15,
+    "tests/splid_jax/reference/test_response.py": 15,
+    "tests/splid_jax/learners/test_es.py": 13,
+    "tests/splid_jax/test_tensorboard.py": 13,
+    "tests/splid_jax/learners/splid/test_select.py": 12,
+    "tests/envs/test_sawyer_door.py": 10,
+}
 
 
 @pytest.hookimpl(optionalhook=True)
 def pytest_xdist_make_scheduler(config, log):
-    """``--dist loadfile`` with the files of ``SHARED_PROGRAMS`` grouped into one unit each."""
+    """``--dist loadfile`` with the files of ``SHARED_PROGRAMS`` grouped into one unit each, and the
+    units of ``UNIT_SECONDS`` handed out first, longest first."""
     if config.getoption("dist") != "loadfile":
         return None
     from xdist.scheduler import LoadFileScheduling
 
+    class HeaviestFirst(collections.OrderedDict):
+        """The work queue: the scheduler pops its next unit from the front, and gets the longest."""
+
+        def popitem(self, last: bool = True):
+            scope = max(self, key=lambda s: UNIT_SECONDS.get(s, 0))  # ties: the first in the queue
+            return scope, self.pop(scope)
+
     class SharedProgramScheduling(LoadFileScheduling):
+        def __init__(self, config, log=None):
+            super().__init__(config, log)
+            self.workqueue = HeaviestFirst()  # not a reordered collection: workers take indices into theirs
+
         def _split_scope(self, nodeid: str) -> str:
             path = super()._split_scope(nodeid)
             return SHARED_PROGRAMS.get(path, path)
