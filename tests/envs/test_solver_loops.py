@@ -20,7 +20,7 @@ def _path(choice: str):
     once for both written-out choices. One substep and one line-search trip per Newton trip keep the
     written-out programs' compiles short; two Newton trips still tell a wrong trip count (about 1e-2)."""
     env = envs.make("push", substeps=1, iterations=2, ls_iterations=1, solver_loops=choice)
-    state = jax.vmap(env.reset)(jax.random.split(jax.random.PRNGKey(0), 4))
+    state = jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, 4)))(jax.random.PRNGKey(0))
     actions = jax.random.uniform(jax.random.PRNGKey(1), (6, 4, 4), minval=-1.0, maxval=1.0)
 
     def step(s, a):
@@ -32,7 +32,7 @@ def _path(choice: str):
 
 def _loop_primitives(**options) -> set[str]:
     env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, **options)
-    state = env.reset(jax.random.PRNGKey(0))
+    state = jax.eval_shape(env.reset, jax.random.PRNGKey(0))  # its shapes are all a trace needs
     text = str(jax.make_jaxpr(env.step)(state, jnp.zeros(4)))
     return {p for p in ("while[", "scan[") if p in text}
 
@@ -46,7 +46,7 @@ def test_written_out_solver_leaves_no_loop_in_the_step():
 
 def test_written_out_line_search_keeps_the_newton_loop_alone():
     env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, solver_loops="search")
-    text = str(jax.make_jaxpr(env.step)(env.reset(jax.random.PRNGKey(0)), jnp.zeros(4)))
+    text = str(jax.make_jaxpr(env.step)(jax.eval_shape(env.reset, jax.random.PRNGKey(0)), jnp.zeros(4)))
     assert text.count("while[") == 1 and text.count("scan[") == 1  # the Newton loop and the substeps'
 
 
