@@ -16,7 +16,7 @@ def test_slices_give_what_one_vmap_gives():
     env = envs.make("point")
     n = 2 * CPU_STEP_SLICE + 37  # two whole slices and a remainder
     keys = jax.random.split(jax.random.PRNGKey(0), n)
-    state = jax.vmap(env.reset)(keys)
+    state = jax.jit(jax.vmap(env.reset))(keys)
     action = jax.random.uniform(jax.random.PRNGKey(1), (n, env.action_size), minval=-1.0, maxval=1.0)
     sliced = jax.jit(lambda s, a: step_batch(env, s, a))(state, action)
     whole = jax.jit(jax.vmap(env.step))(state, action)
@@ -27,7 +27,7 @@ def test_a_cpu_computation_on_an_accelerator_host_is_sliced(monkeypatch, primiti
     # a CPU peer on a GPU host: the default backend is the GPU, the default device the CPU
     env = envs.make("point")
     n = CPU_STEP_SLICE + 1
-    state = jax.vmap(env.reset)(jax.random.split(jax.random.PRNGKey(0), n))
+    state = jax.eval_shape(jax.vmap(env.reset), jax.random.split(jax.random.PRNGKey(0), n))  # a trace's shapes
     action = jax.numpy.zeros((n, env.action_size))
 
     def prims():
@@ -44,7 +44,7 @@ def test_a_cpu_computation_on_an_accelerator_host_is_sliced(monkeypatch, primiti
 @pytest.mark.parametrize("name", envs.names())
 def test_the_achieved_goal_sits_where_the_task_says_and_success_ends_at_its_distance(name):
     env = envs.make(name)
-    s = jax.vmap(env.reset)(jax.random.split(jax.random.PRNGKey(0), 4))
+    s = jax.jit(jax.vmap(env.reset))(jax.random.split(jax.random.PRNGKey(0), 4))
     start = env.achieved_goal_start
     np.testing.assert_array_equal(s.obs[:, start : start + env.goal_size], s.achieved_goal)
     direction = jnp.zeros(env.goal_size).at[0].set(1.0)
@@ -68,6 +68,6 @@ def test_each_task_step_is_traced_once_whatever_the_batch_sizes():
     env = _CountedPoint()
     equal = _CountedPoint()  # another object, the same task: the same trace
     for task, n in ((env, 3), (env, 5), (equal, 7)):  # exploration, evaluation, SELECT: their own batch sizes
-        state = jax.vmap(task.reset)(jax.random.split(jax.random.PRNGKey(0), n))
+        state = jax.eval_shape(jax.vmap(task.reset), jax.random.split(jax.random.PRNGKey(0), n))
         jax.make_jaxpr(lambda s, a, task=task: step_batch(task, s, a))(state, jnp.zeros((n, task.action_size)))
     assert _TRACES == [(env.action_size,)]  # the unbatched step, once
