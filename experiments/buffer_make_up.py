@@ -1,0 +1,57 @@
+"""What a sweep's relabel buffers hold at its latest checkpoint, per member: the share of pairs whose goal is
+where the object already is (held goals, those that teach staying on a reached goal), of goals and states
+lifted above the object's resting height, and how far the other goals lie (``final_step.buffer_make_up``).
+
+    python experiments/buffer_make_up.py SWEEP_DIR [--out FILE.json]
+
+Run it on a checkpoint kept at the peak and on a later one to see whether what the buffer teaches changed."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+
+import jax
+import numpy as np
+from final_step import buffer_make_up
+
+from splid_jax.config import TrainConfig
+from splid_jax.learners.registry import make_algorithm
+from splid_jax.runtime import checkpoint
+from splid_jax.runtime.loop import make_env
+
+
+def make_up(sweep_dir: str) -> dict:
+    with open(os.path.join(sweep_dir, "sweep.json")) as fh:
+        saved = json.load(fh)
+    cfg = TrainConfig.from_json(saved["config"], run_dir=sweep_dir)
+    env = make_env(cfg.env, **cfg.env_overrides())
+    algo = make_algorithm(cfg, env)
+    members = len(saved["members"])
+    like = jax.eval_shape(jax.vmap(algo.init), jax.random.split(jax.random.PRNGKey(0), members))
+    step, state, _ = checkpoint.restore(sweep_dir, like, step=None)
+    rows = jax.device_get(jax.vmap(lambda b: buffer_make_up(env, b))(state.buffer))
+    return {
+        "sweep": os.path.abspath(sweep_dir),
+        "iteration": int(step),
+        "members": [m.get("run_dir") for m in saved["members"]],
+        **{k: np.asarray(v, np.float64).round(4).tolist() for k, v in rows.items()},
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("sweep_dir")
+    p.add_argument("--out", default=None)
+    a = p.parse_args(argv)
+    result = make_up(a.sweep_dir)
+    print(json.dumps(result))
+    if a.out:
+        with open(a.out, "w") as fh:
+            json.dump(result, fh, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
