@@ -17,9 +17,9 @@ from envs import solver_loops
 @functools.cache
 def _path(choice: str):
     """Six steps of four envs with the solver's loops as ``choice`` has them; the loops' path is computed
-    once for both written-out choices. One substep and one line-search trip per Newton trip keep the
-    written-out programs' compiles short; two Newton trips still tell a wrong trip count (about 1e-2)."""
-    env = envs.make("push", substeps=1, iterations=2, ls_iterations=1, solver_loops=choice)
+    once for both written-out choices. One substep keeps the written-out programs' compiles short; two
+    Newton trips of two line-search trips each tell a wrong count of either (about 1e-2)."""
+    env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, solver_loops=choice)
     state = jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, 4)))(jax.random.PRNGKey(0))
     actions = jax.random.uniform(jax.random.PRNGKey(1), (6, 4, 4), minval=-1.0, maxval=1.0)
 
