@@ -98,6 +98,9 @@ def pytest_xdist_make_scheduler(config, log):
         return None
     from xdist.scheduler import LoadFileScheduling
 
+    if not hasattr(LoadFileScheduling, "_split_scope"):  # another xdist's internals: its own scheduler, unordered
+        return None
+
     class HeaviestFirst(collections.OrderedDict):
         """The work queue: the scheduler pops its next unit from the front, and gets the longest."""
 
