@@ -205,6 +205,18 @@ def _scripted_or_given(env, controller):
     return run
 
 
+def _fresh_starts(env, n: int, seed: int = 0):
+    """``n`` starts of ``env`` from ``PRNGKey(seed)``, jitted (op by op, a vmapped reset takes seconds more)
+    and traced anew at every call, so a draw outside the key would differ between two calls."""
+    return jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, n)))(jax.random.PRNGKey(seed))
+
+
+@pytest.fixture(scope="session")
+def fresh_starts():
+    """``fresh_starts(env, n, seed=0)``: see ``_fresh_starts``."""
+    return _fresh_starts
+
+
 @pytest.fixture(scope="session")
 def episode_program():
     """``episode_program(env, controller)``: one compiled episode program per task and scripted

@@ -14,25 +14,20 @@ from splid_jax.common.errors import InvalidConfig
 N = 8
 
 
-def _starts(env):
-    """``N`` starts from ``PRNGKey(0)``, jitted (op by op, the vmapped reset takes seconds more)."""
-    return jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, N)))(jax.random.PRNGKey(0))
-
-
 @pytest.fixture(scope="module")
 def env():
     return envs.make("sawyer_door")
 
 
 @pytest.fixture(scope="module")
-def episodes(env, episode_program):
-    start = _starts(env)
+def episodes(env, episode_program, fresh_starts):
+    start = fresh_starts(env, N)
     noise = jax.random.uniform(jax.random.PRNGKey(1), (env.episode_length, N, 3), minval=-1.0, maxval=1.0)
     run = episode_program(env, scripted)
     return start, noise, run(start, noise, False), run(start, noise, True)
 
 
-def test_contract_shapes_and_goal_ranges(env, episodes):
+def test_contract_shapes_and_goal_ranges(env, episodes, fresh_starts):
     start, _, (states, actions), _ = episodes
     assert (env.obs_size, env.goal_size, env.action_size, env.episode_length) == (4, 1, 3, 50)
     assert states.obs.shape == (50, N, 4) and states.obs.dtype == jnp.float32
@@ -43,7 +38,7 @@ def test_contract_shapes_and_goal_ranges(env, episodes):
     np.testing.assert_array_equal(states.obs[..., :3], states.physics.qpos[..., 1:4])
     np.testing.assert_array_equal(start.obs[:, 3], 0.0)  # every episode starts with the door closed
     assert 0.0 <= float(jnp.min(start.desired_goal)) and float(jnp.max(start.desired_goal)) <= GOAL_MAX
-    same = _starts(env)  # traced anew: a draw outside the key would differ
+    same = fresh_starts(env, N)  # traced anew: a draw outside the key would differ
     np.testing.assert_array_equal(same.obs, start.obs)  # a key fixes the start and the goal
     np.testing.assert_array_equal(same.desired_goal, start.desired_goal)
     assert not bool(jnp.any(states.invalid))
