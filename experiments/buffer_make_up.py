@@ -16,26 +16,18 @@ import jax
 import numpy as np
 from final_step import buffer_make_up
 
-from splid_jax.config import TrainConfig
-from splid_jax.learners.registry import make_algorithm
-from splid_jax.runtime import checkpoint
-from splid_jax.runtime.loop import make_env
+from splid_jax.reference.policy import restore_sweep
 
 
 def make_up(sweep_dir: str) -> dict:
+    env, _, state, step, _ = restore_sweep(sweep_dir)
     with open(os.path.join(sweep_dir, "sweep.json")) as fh:
-        saved = json.load(fh)
-    cfg = TrainConfig.from_json(saved["config"], run_dir=sweep_dir)
-    env = make_env(cfg.env, **cfg.env_overrides())
-    algo = make_algorithm(cfg, env)
-    members = len(saved["members"])
-    like = jax.eval_shape(jax.vmap(algo.init), jax.random.split(jax.random.PRNGKey(0), members))
-    step, state, _ = checkpoint.restore(sweep_dir, like, step=None)
+        members = [m.get("run_dir") for m in json.load(fh)["members"]]
     rows = jax.device_get(jax.vmap(lambda b: buffer_make_up(env, b))(state.buffer))
     return {
         "sweep": os.path.abspath(sweep_dir),
         "iteration": int(step),
-        "members": [m.get("run_dir") for m in saved["members"]],
+        "members": members,
         **{k: np.asarray(v, np.float64).round(4).tolist() for k, v in rows.items()},
     }
 

@@ -28,23 +28,39 @@ def sweep_member(run_dir: str) -> tuple[str, int, int] | None:
     return (parent, names.index(name), len(names)) if name in names else None
 
 
-def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
-    """A sweep member's task, algorithm, state and step, sliced out of the sweep's stacked checkpoint
-    (laid out as the sweep's own config builds it; members differ only in data, not in shapes)."""
+def restore_sweep(directory: str, env=None, step: int | None = None):
+    """(task, algorithm, state stacked over members, step, checkpoint record) of the sweep in ``directory``,
+    laid out as the sweep's own config builds it; ``env``: the task to build the algorithm on (default: the
+    sweep's own)."""
     import jax
 
     from splid_jax.config import TrainConfig
     from splid_jax.learners.registry import make_algorithm
     from splid_jax.runtime import checkpoint
     from splid_jax.runtime.loop import make_env
-    from splid_jax.runtime.run_files import note_task_changes
 
-    directory, index, members = sweep
-    env = make_env(cfg.env, **cfg.env_overrides())  # the member's task, with any changed fields
     with open(os.path.join(directory, "sweep.json")) as fh:
-        trainer = make_algorithm(TrainConfig.from_json(json.load(fh)["config"], run_dir=directory), env)
+        saved = json.load(fh)
+    cfg = TrainConfig.from_json(saved["config"], run_dir=directory)
+    env = make_env(cfg.env, **cfg.env_overrides()) if env is None else env
+    trainer = make_algorithm(cfg, env)
+    members = len(saved.get("members", []))
     like = jax.eval_shape(jax.vmap(trainer.init), jax.random.split(jax.random.PRNGKey(0), members))
     step, state, meta = checkpoint.restore(directory, like, step=step)
+    return env, trainer, state, step, meta
+
+
+def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
+    """A sweep member's task, algorithm, state and step, sliced out of the sweep's stacked checkpoint
+    (members differ only in data, not in shapes)."""
+    import jax
+
+    from splid_jax.runtime.loop import make_env
+    from splid_jax.runtime.run_files import note_task_changes
+
+    directory, index, _ = sweep
+    env = make_env(cfg.env, **cfg.env_overrides())  # the member's task, with any changed fields
+    env, trainer, state, step, meta = restore_sweep(directory, env, step)
     note_task_changes(cfg.run_dir, meta.get("env", {}), env)
     return env, trainer, jax.tree.map(lambda x: x[index], state), step
 
