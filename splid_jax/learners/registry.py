@@ -61,7 +61,7 @@ _IMITATION = dict(
 # 3,200 the 51,200 episodes of the SPLID runs there.
 _HER_FETCH = dict(num_envs=16, eval_every=50)
 # Steered exploration was chosen for SPLID; the baselines explore towards the goal, as their papers do
-_UNSTEERED = {"push": {"explore_subgoal_reach": 0.0}, "pick_and_place": {"explore_subgoal_reach": 0.0}}
+_UNSTEERED = {task: {"explore_subgoal_reach": 0.0} for task in ("push", "slide", "pick_and_place")}
 
 LEARNERS: dict[str, Learner] = {
     learner.name: learner

@@ -128,13 +128,14 @@ def test_pick_and_place_trains_from_grasped_starts_unless_told_otherwise():
     assert TrainConfig(env="push").env_options == ""
 
 
-def test_push_and_pick_and_place_evaluate_with_subgoals_and_runs_recorded_before_them_read_back_without():
+def test_the_fetch_tasks_but_reach_evaluate_with_subgoals_and_runs_recorded_before_them_read_back_without():
     from splid_jax.runtime.run_files import identity
 
     assert TrainConfig(env="push").eval_subgoal_reach == 0.1
     assert TrainConfig(env="push", algo="her").eval_subgoal_reach == 0.1  # one controller for every learner
     assert TrainConfig(env="pick_and_place").eval_subgoal_reach == 0.1
-    assert TrainConfig(env="slide").eval_subgoal_reach == TrainConfig(env="point").eval_subgoal_reach == 0.0
+    assert TrainConfig(env="slide").eval_subgoal_reach == 0.1
+    assert TrainConfig(env="reach").eval_subgoal_reach == TrainConfig(env="point").eval_subgoal_reach == 0.0
     before = {k: v for k, v in TrainConfig(env="push").to_json().items() if k != "eval_subgoal_reach"}
     assert TrainConfig.from_json(before).eval_subgoal_reach == 0.0  # evaluated as it was
     assert "eval_subgoal_reach" not in identity(TrainConfig.from_json(before))  # and resumes from its checkpoint
@@ -143,7 +144,7 @@ def test_push_and_pick_and_place_evaluate_with_subgoals_and_runs_recorded_before
         TrainConfig(env="push", eval_subgoal_reach=-0.1)
 
 
-def test_splid_explores_steered_on_push_and_pick_and_place_and_the_baselines_towards_the_goal():
+def test_splid_explores_steered_on_push_slide_and_pick_and_place_and_the_baselines_towards_the_goal():
     from splid_jax.runtime.run_files import identity
 
     assert TrainConfig(env="push").explore_subgoal_reach == 0.1
@@ -151,7 +152,9 @@ def test_splid_explores_steered_on_push_and_pick_and_place_and_the_baselines_tow
     assert TrainConfig(env="pick_and_place", algo="gcsl").explore_subgoal_reach == 0.0  # baselines as published
     assert TrainConfig(env="push", algo="pchid").explore_subgoal_reach == 0.0
     assert TrainConfig(env="push", algo="pchid", explore_subgoal_reach=0.1).explore_subgoal_reach == 0.1
-    assert TrainConfig(env="slide").explore_subgoal_reach == TrainConfig(env="point").explore_subgoal_reach == 0.0
+    assert TrainConfig(env="slide").explore_subgoal_reach == 0.1
+    assert TrainConfig(env="slide", algo="gcsl").explore_subgoal_reach == 0.0
+    assert TrainConfig(env="reach").explore_subgoal_reach == TrainConfig(env="point").explore_subgoal_reach == 0.0
     assert TrainConfig(env="push", algo="her").explore_subgoal_reach == 0.0  # HER explores with its own noise
     assert TrainConfig(env="pick_and_place", algo="es").explore_subgoal_reach == 0.0
     before = {k: v for k, v in TrainConfig(env="push").to_json().items() if k != "explore_subgoal_reach"}
