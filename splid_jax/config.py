@@ -330,11 +330,28 @@ _FETCH = dict(
     eval_subgoal_reach=0.0,
     explore_subgoal_reach=0.0,
 )
+# PickAndPlace's SPLID settings, which Slide shares without the grasped starts: held goals, Push's earlier settings
+# at 512 envs, exploring and evaluated steered at subgoals within 0.10 m. The reaches were chosen on seeds 1000-1002
+# on both tasks (evaluation: the best of 0.05 to 0.20 m on PickAndPlace, 0.05 to 0.30 m on Slide; exploration:
+# against 0 on both, and 0.20 m on Slide) and reported on fresh seeds (PickAndPlace 2000-2004 and 4000-4004, Slide
+# 2000-2004).
+_HELD_STEERED: dict[str, Any] = {
+    **_FETCH,
+    "num_envs": 512,
+    "relabel": "hold",
+    "normalise": False,
+    "relative_goal": True,
+    "sigma_end": 0.5,
+    "sigma_anneal": 50,
+    "policy_ema": 0.98,
+    "learning_rate": 5e-4,
+    "eval_subgoal_reach": 0.1,
+    "explore_subgoal_reach": 0.1,
+}
 # Push's, Reach's, Slide's and PickAndPlace's settings are those that learned best where they were compared (on
-# PickAndPlace: with the reference's finger joints, the earlier Push settings, held goals and half the training
-# episodes started with the cube grasped, HER 2017's protocol; evaluation starts are standard; Slide: PickAndPlace's
-# without grasped starts, against Algorithm 2 at 1,024 envs) (experiments/NOTES.md, "Task defaults"; BENCHMARKS.md,
-# "Push", "Slide", "PickAndPlace" and "Final-step success").
+# PickAndPlace: with the reference's finger joints and half the training episodes started with the cube grasped, HER
+# 2017's protocol; evaluation starts are standard; Slide: against Algorithm 2 at 1,024 envs) (experiments/NOTES.md,
+# "Task defaults"; BENCHMARKS.md, "Push", "Slide", "PickAndPlace" and "Final-step success").
 TASK_DEFAULTS: dict[str, dict[str, Any]] = {
     "point": _POINT,
     "reach": {**_FETCH, "iterations": 20, "num_envs": 64, "relative_goal": True},
@@ -356,35 +373,15 @@ TASK_DEFAULTS: dict[str, dict[str, Any]] = {
         "explore_subgoal_reach": 0.1,  # against 0: learns faster on seeds 1000-1004, reported on 5000-5004
     },
     "slide": {
-        **_FETCH,
+        **_HELD_STEERED,
         "iterations": 100,
-        "num_envs": 512,
-        "relabel": "hold",
-        "normalise": False,
-        "relative_goal": True,
-        "sigma_end": 0.5,
-        "sigma_anneal": 50,
         "buffer_size": 50_000,  # 100k held later on seeds 1000-1002 (0.420 against 0.390 at 51,200); not yet reported
-        "policy_ema": 0.98,
-        "learning_rate": 5e-4,
-        "eval_subgoal_reach": 0.1,  # the best of 0.05 to 0.30 m on seeds 1000-1002, reported on 2000-2004
-        "explore_subgoal_reach": 0.1,  # against 0 and 0.20 m on seeds 1000-1002, reported on 2000-2004
     },
     "pick_and_place": {
-        **_FETCH,
+        **_HELD_STEERED,
         "env_options": "grasped_starts=0.5",
         "iterations": 40,
-        "num_envs": 512,
-        "relabel": "hold",
-        "normalise": False,
-        "relative_goal": True,
-        "sigma_end": 0.5,
-        "sigma_anneal": 50,
         "buffer_size": 100_000,  # against 50k on seeds 1000-1002 to 30,720 episodes, reported on 6000-6004
-        "policy_ema": 0.98,
-        "learning_rate": 5e-4,
-        "eval_subgoal_reach": 0.1,  # the best of 0.05 to 0.20 m on seeds 1000-1002, reported on 2000-2004
-        "explore_subgoal_reach": 0.1,  # against 0 on seeds 1000-1002, reported against 0 on 4000-4004
     },
     "reacher": {**_POINT, "iterations": 40},
     "sawyer_door": {**_POINT, "iterations": 40},
