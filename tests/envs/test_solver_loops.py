@@ -15,10 +15,11 @@ from envs import solver_loops
 
 
 @functools.cache
-def _path(choice: str):
-    """Six steps of four envs with the solver's loops as ``choice`` has them; the loops' path is computed
-    once for both written-out choices. One substep keeps the written-out programs' compiles short; two
-    Newton trips of two line-search trips each tell a wrong count of either (about 1e-2)."""
+def _program(choice: str):
+    """Six steps of four envs with the solver's loops as ``choice`` has them: the traced episode program
+    and its start. One substep keeps the written-out programs' compiles short; two Newton trips of two
+    line-search trips each tell a wrong count of either (about 1e-2). The loop checks below read this
+    program's jaxpr, so each choice that runs is traced once."""
     env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, solver_loops=choice)
     state = jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, 4)))(jax.random.PRNGKey(0))
     actions = jax.random.uniform(jax.random.PRNGKey(1), (6, 4, 4), minval=-1.0, maxval=1.0)
@@ -27,27 +28,45 @@ def _path(choice: str):
         s = jax.vmap(env.step)(s, a)
         return s, s.physics.qpos
 
-    return np.asarray(jax.jit(lambda s: jax.lax.scan(step, s, actions)[1])(state))
+    return jax.jit(lambda s: jax.lax.scan(step, s, actions)[1]).trace(state), state
 
 
-def _loop_primitives(**options) -> set[str]:
-    env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, **options)
-    state = jax.eval_shape(env.reset, jax.random.PRNGKey(0))  # its shapes are all a trace needs
-    text = str(jax.make_jaxpr(env.step)(state, jnp.zeros(4)))
-    return {p for p in ("while[", "scan[") if p in text}
+@functools.cache
+def _path(choice: str):
+    """The qpos path of ``_program(choice)``; the loops' path is computed once for both written-out choices."""
+    traced, state = _program(choice)
+    return np.asarray(traced.lower().compile()(state))
+
+
+def _loop_counts(text: str, episode_scans: int = 0) -> dict[str, int]:
+    """How many while and scan loops ``text`` (a jaxpr) holds, less the episode's own ``episode_scans``."""
+    return {"while[": text.count("while["), "scan[": text.count("scan[") - episode_scans}
+
+
+def _loop_primitives(choice: str | None = None) -> set[str]:
+    """The loop primitives of the step with the solver's loops as ``choice`` has them: read from the
+    episode program that runs (less its episode scan) where the tests run that choice, else from a
+    trace of the lone step."""
+    if choice in ("loops", "unrolled", "search"):
+        counts = _loop_counts(str(_program(choice)[0].jaxpr), episode_scans=1)
+    else:
+        options = {} if choice is None else {"solver_loops": choice}
+        env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, **options)
+        state = jax.eval_shape(env.reset, jax.random.PRNGKey(0))  # its shapes are all a trace needs
+        counts = _loop_counts(str(jax.make_jaxpr(env.step)(state, jnp.zeros(4))))
+    return {p for p, n in counts.items() if n > 0}
 
 
 def test_written_out_solver_leaves_no_loop_in_the_step():
-    assert _loop_primitives(solver_loops="loops") == {"while[", "scan["}  # Newton, its line search, the substeps
-    assert _loop_primitives(solver_loops="unrolled") == {"scan["}  # the substeps' loop alone
-    assert _loop_primitives(solver_loops="auto") == {"while[", "scan["}  # the loops on the CPU
+    assert _loop_primitives("loops") == {"while[", "scan["}  # Newton, its line search, the substeps
+    assert _loop_primitives("unrolled") == {"scan["}  # the substeps' loop alone
+    assert _loop_primitives("auto") == {"while[", "scan["}  # the loops on the CPU
     assert _loop_primitives() == {"while[", "scan["}  # the default, gpu-search: the loops on the CPU
 
 
 def test_written_out_line_search_keeps_the_newton_loop_alone():
-    env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, solver_loops="search")
-    text = str(jax.make_jaxpr(env.step)(jax.eval_shape(env.reset, jax.random.PRNGKey(0)), jnp.zeros(4)))
-    assert text.count("while[") == 1 and text.count("scan[") == 1  # the Newton loop and the substeps'
+    counts = _loop_counts(str(_program("search")[0].jaxpr), episode_scans=1)
+    assert counts == {"while[": 1, "scan[": 1}  # the Newton loop and the substeps'
 
 
 def test_gpu_choices_write_the_solver_out_on_a_gpu_only():
