@@ -73,7 +73,9 @@ def test_train_writes_every_record_to_tensorboard(tmp_path):
     from splid_jax import train
 
     run_dir, log_dir = tmp_path / "run", tmp_path / "tb"
-    argv = ["--env", "point", "--iterations", "10", "--num-envs", "8", "--eval-episodes", "8", "--bc-steps", "5"]
+    # test_train's TINY run (two records): its program comes from the compile cache when that file ran first
+    argv = ["--env", "point", "--iterations", "10", "--num-envs", "8", "--eval-episodes", "16", "--bc-steps", "40",
+            "--batch-size", "64", "--hidden", "32,32", "--eval-every", "5"]  # fmt: skip
     argv += ["--run-dir", str(run_dir), "--quiet", "--compile-cache", "", "--tensorboard", str(log_dir)]
     assert train.main(argv) == 0
     records = [json.loads(line) for line in (run_dir / "metrics.jsonl").read_text().splitlines()]
@@ -86,8 +88,10 @@ def test_sweep_writes_each_member_under_its_own_name(tmp_path):
     from splid_jax import sweep
 
     run_dir, log_dir = tmp_path / "sweep", tmp_path / "tb"
-    argv = ["--env", "point", "--seeds", "2", "--iterations", "5", "--num-envs", "8", "--eval-episodes", "8"]
-    argv += ["--bc-steps", "5", "--run-dir", str(run_dir), "--quiet", "--no-plot", "--compile-cache", ""]
+    # test_sweep's resumed sweep at its sizes (two members, two records each), so its program may come from the cache
+    argv = ["--env", "point", "--num-envs", "4", "--eval-episodes", "8", "--eval-every", "2", "--bc-steps", "5",
+            "--batch-size", "16", "--hidden", "16", "--seeds", "2", "--horizons", "4", "--iterations", "4"]  # fmt: skip
+    argv += ["--run-dir", str(run_dir), "--quiet", "--no-plot", "--compile-cache", ""]
     assert sweep.main([*argv, "--tensorboard", str(log_dir)]) == 0
     for member in sorted(p.name for p in run_dir.iterdir() if (p / "metrics.jsonl").is_file()):
         records = [json.loads(line) for line in (run_dir / member / "metrics.jsonl").read_text().splitlines()]
