@@ -23,15 +23,11 @@ timed runs from S (a saved state restored and replayed with the same actions; 0 
 for warp, ``restore from physics`` replays from a fresh warp Data holding only S's qpos, qvel, ctrl,
 time and qacc_warmstart (what the trainer's ``State`` keeps). ``jax - warp`` is the difference of the
 two implementations' warm-up trajectories (same reset states, same actions) after 1 and 50 control
-steps, reported, not judged. On the CPU (batch 4, seed 0) it was 2e-8 m after 1 step and 3e-3 m in the
-gripper after 4: at Push's cap of 4 Newton iterations the solve is cut short there, MJX's JAX iterates
-follow MuJoCo's (C, float64) to 3e-5 m and Warp's do not; with 10 iterations for all three they agree to
-1e-8 m (``--warp-iterations`` sets Warp's cap alone). Warp's overflow bits (``OverflowType``) after the
-last run are listed when any is set.
-
-On a 2-core CPU (warp-lang 1.19.0 and 1.18.0, Warp's CPU device; batch 4, 5 steps) both ran and both
-replays were exact; Warp took about 200 ms per control step against 4 ms for JAX, so its CPU timings say
-nothing about a GPU. Warp's CPU kernels need warp/bin/warp-clang.so, which a CUDA-only install may drop.
+steps, reported, not judged: where Push's cap of 4 Newton iterations cuts the solve short the two
+backends stop at different iterates, so ``--warp-iterations`` sets Warp's cap alone, to time it at equal
+physics too (experiments/NOTES.md, "MJX's Warp backend"). Warp's overflow bits (``OverflowType``) after
+the last run are listed when any is set. Warp's CPU kernels need warp/bin/warp-clang.so, which a
+CUDA-only install may drop.
 
 Examples::
 
