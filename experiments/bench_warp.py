@@ -4,7 +4,7 @@ trainer uses, at small batches, and whether restoring a saved state and replayin
 For each batch a jitted ``lax.scan`` of ``--steps`` control steps (each ``substeps`` MJX steps, 10 for
 Push) is compiled for each implementation; its inputs are the batched state and the actions, its
 outputs the final state and the qpos/qvel after every control step. The actions are uniform in [-1, 1]
-and turned into controls by the task's own ``_control`` (as ``env.step`` does), so both implementations
+and turned into controls by the task's own ``_action`` and ``_control`` (as ``env.step`` does), so both implementations
 get the same actions and the same control law.
 
 - ``jax``: the trainer's step, ``env.simulate`` (MJX's JAX implementation with the task's written-out
@@ -94,19 +94,11 @@ def physics_names(env) -> list[str]:
     return [f.name for f in dataclasses.fields(physics_cls(env))]
 
 
-def env_action(env, action: jax.Array) -> jax.Array:
-    """``env.step``'s treatment of an action before its control law."""
-    action = jnp.clip(action, -1.0, 1.0)
-    if env.block_gripper:
-        action = action.at[..., 3].set(0.0)
-    return action
-
-
 def jax_program(env):
     """(physics, actions[steps, B, 4]) -> (physics, qpos[steps, B, nq], qvel[steps, B, nv])."""
 
     def one(phys, action):
-        return env.simulate(phys, env._control(phys, env_action(env, action)))
+        return env.simulate(phys, env._control(phys, env._action(action)))
 
     def run(phys, actions):
         def body(p, a):
@@ -127,7 +119,7 @@ def warp_program(env, mw, names: list[str]):
     def run(d, actions):
         def body(d, a):
             phys = phys_cls(**{n: getattr(d, n) for n in names})
-            ctrl = jax.vmap(env._control)(phys, env_action(env, a))
+            ctrl = jax.vmap(env._control)(phys, env._action(a))
             d = jax.lax.fori_loop(0, env.substeps, lambda _, x: step(mw, x), d.replace(ctrl=ctrl))
             return d, (d.qpos, d.qvel)
 

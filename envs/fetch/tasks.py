@@ -338,12 +338,17 @@ class _FetchTask(GoalEnv):
             with solver_loops.unrolled_in_mjx(self.iterations, newton, line_search):
                 return mjx_substeps(model, data, phys.replace(ctrl=ctrl), self.substeps)
 
-    def step(self, state: State, action: jax.Array) -> State:
+    def _action(self, action: jax.Array) -> jax.Array:
+        """The action (any leading batch axes) as the control law reads it: clipped to [-1, 1], the fingers'
+        command zeroed where they are locked."""
         action = jnp.clip(action, -1.0, 1.0)
         if self.block_gripper:
-            action = action.at[3].set(0.0)
+            action = action.at[..., 3].set(0.0)
+        return action
+
+    def step(self, state: State, action: jax.Array) -> State:
         phys = state.physics
-        phys = self.simulate(phys, self._control(phys, action))
+        phys = self.simulate(phys, self._control(phys, self._action(action)))
         out = self._state(phys, state.desired_goal, state.step + 1, state.invalid)
         return flag_invalid(out)
 
