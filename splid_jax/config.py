@@ -135,6 +135,14 @@ class TrainConfig:
     select_lanes: float = field(
         None, "parallel SELECT replay lanes as a fraction of the T x N explored steps (speed only, never a verdict)"
     )
+    held_share: float = field(
+        0.0,
+        "splid, pchid with held goals (relabel hold, settle, rest or stop): the share of each behaviour-cloning "
+        "minibatch drawn from the buffer's held-goal pairs, those whose goal is where the object already is, "
+        "which teach staying on a reached goal (0: uniform over every pair, the paper's sampling)",
+        recorded_when_set=True,
+        unrecorded=0.0,
+    )
     buffer_size: int = field(None, "relabel buffer capacity (FIFO)")
     batch_size: int = field(None, "behaviour-cloning minibatch size")
     bc_steps: int = field(None, "behaviour-cloning gradient steps per iteration")

@@ -35,9 +35,11 @@ class Learner:
 
 
 IMITATION_FIELDS = tuple(f.name for f in dataclasses.fields(ImitationConfig))
-# SELECT's settings, read by SPLID and PCHID; GCSL clones every relabelled pair and selects nothing
+# SELECT's settings and the share of the held pairs it makes in BC's batches, read by SPLID and PCHID; GCSL
+# clones every relabelled pair and selects nothing
 SELECT_FIELDS = (
-    "horizon", "horizon_end", "hold_horizon", "rest_horizon", "select", "relabel", "select_radius", "select_lanes"
+    "horizon", "horizon_end", "hold_horizon", "rest_horizon", "select", "relabel", "select_radius", "select_lanes",
+    "held_share",
 )
 _CLONING = tuple(f for f in IMITATION_FIELDS if f not in (*SELECT_FIELDS, "gcsl_relabel", "pchid_every"))
 _TRAINER = "splid_jax.learners.splid.trainer:Trainer"
@@ -53,6 +55,7 @@ _IMITATION = dict(
         "policy_ema",
         "gripper_hold",
         "explore_subgoal_reach",
+        "held_share",
     ),
 )
 # HER on the Fetch tasks runs as OpenAI Baselines: a cycle explores 2 episodes on each of 8 workers

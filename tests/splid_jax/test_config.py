@@ -67,6 +67,15 @@ def test_select_horizons_outside_their_range_name_the_field(fields):
         TrainConfig(env="point", **fields)
 
 
+@pytest.mark.parametrize(
+    "fields", [{"held_share": -0.1}, {"held_share": 1.0}, {"held_share": 0.2, "relabel": "paper"}]
+)
+def test_held_share_outside_its_range_or_without_held_goals_names_the_field(fields):
+    with pytest.raises(InvalidConfig, match="held_share"):
+        TrainConfig(env="point", **fields)
+    assert TrainConfig(env="point", held_share=0.2, relabel="hold").held_share == 0.2
+
+
 def test_rest_horizon_within_the_episode_is_accepted():
     cfg = TrainConfig(env="point", relabel="rest", horizon=4, rest_horizon=16, hold_horizon=2)
     assert (cfg.rest_horizon, cfg.hold_horizon) == (16, 2)

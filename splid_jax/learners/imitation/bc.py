@@ -55,13 +55,17 @@ def bc_epoch(
     batch_size: int,
     online=None,
     acting_step: float | jax.Array = 1.0,
+    held: jax.Array | None = None,
+    held_share: float | jax.Array = 0.0,
 ):
-    """``num_steps`` minibatch steps from the buffer; returns (pstate, opt_state, online, mean loss)."""
+    """``num_steps`` minibatch steps from the buffer; returns (pstate, opt_state, online, mean loss).
+    ``held`` ([C] bool, the held-goal pairs) lets ``held_share`` of each batch come from them."""
     weight = (buf.size > 0).astype(jnp.float32)
+    slots = None if held is None else relabel_buffer.held_slots(held)
 
     def one(carry, k):
         ps, os, on = carry
-        batch = relabel_buffer.sample(buf, k, batch_size)
+        batch = relabel_buffer.sample(buf, k, batch_size, slots, held_share)
         ps, os, on, loss = bc_step(policy, optimiser, ps, os, batch, weight, on, acting_step)
         return (ps, os, on), loss
 

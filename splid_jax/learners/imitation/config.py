@@ -37,6 +37,7 @@ class ImitationConfig:
     gcsl_relabel: str
     pchid_every: int
     select_lanes: float
+    held_share: float
     buffer_size: int
     batch_size: int
     bc_steps: int
@@ -77,6 +78,14 @@ class ImitationConfig:
             f"0, or with relabel=rest an integer above the horizon {self.horizon}",
         )
         check(0 < self.select_lanes <= 1, "select_lanes", self.select_lanes, "in (0, 1]")
+        share = self.held_share
+        check(0 <= share < 1, "held_share", share, "in [0, 1) (0: uniform sampling)")
+        check(
+            share == 0 or self.relabel in HOLDING,
+            "held_share",
+            share,
+            f"0 with relabel={self.relabel}, which adds no held goals (they come with " + ", ".join(HOLDING) + ")",
+        )
         check(self.buffer_size >= 1, "buffer_size", self.buffer_size, "an integer >= 1")
         check(self.batch_size >= 1, "batch_size", self.batch_size, "an integer >= 1")
         check(self.bc_steps >= 1, "bc_steps", self.bc_steps, "an integer >= 1 (no step leaves the loss undefined)")

@@ -63,6 +63,13 @@ def within(env: GoalEnv, achieved: jax.Array, goal: jax.Array, radius: float = 1
     return env.success(goal + (achieved - goal) / radius, goal)
 
 
+def held_pairs(env: GoalEnv, obs: jax.Array, goal: jax.Array, radius: float = 1.0) -> jax.Array:
+    """Which stored (observation, goal) pairs are held-goal ones: the goal already achieved at the
+    observation, the test that sets SELECT's held candidates apart from its moved ones."""
+    start = env.achieved_goal_start
+    return within(env, obs[..., start : start + env.goal_size], goal, radius)
+
+
 def replay_queue(
     env: GoalEnv,
     policy: Policy,

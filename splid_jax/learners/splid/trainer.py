@@ -20,9 +20,9 @@ from splid_jax.learners.base import Chunked
 from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.bc import bc_epoch
 from splid_jax.learners.imitation.candidates import Candidates
-from splid_jax.learners.imitation.config import ImitationConfig, select_modes
+from splid_jax.learners.imitation.config import HOLDING, ImitationConfig, select_modes
 from splid_jax.learners.imitation.explore import Seen, Trajectory, draws, hold_fingers, rollout
-from splid_jax.learners.splid.select import select
+from splid_jax.learners.splid.select import held_pairs, select
 from splid_jax.runtime.devices import ENVS
 
 
@@ -49,6 +49,7 @@ class Hyper:
     acting_step: jax.Array  # [] float32: 1 - policy_ema, taken in double as a constant's would be
     gripper_hold: jax.Array  # [] int32, steps the fingers' noise is held (tasks that move them)
     explore_reach: jax.Array  # [] float32, exploration's subgoal reach (inf: the goal itself)
+    held_share: jax.Array  # [] float32, the share of BC's batches drawn from the held-goal pairs
 
 
 class Trainer(Chunked):
@@ -98,6 +99,7 @@ class Trainer(Chunked):
             acting_step=jnp.float32(1.0 - bc.policy_ema),
             gripper_hold=jnp.int32(bc.gripper_hold),
             explore_reach=traced_reach(bc.explore_subgoal_reach),
+            held_share=jnp.float32(bc.held_share),
         )
 
     def init(self, key: jax.Array) -> TrainState:
@@ -186,8 +188,23 @@ class Trainer(Chunked):
         settings become BC's arguments. Returns (pstate, opt_state, online, mean loss)."""
         bc = self.bc
         optimiser = optax.adam(hyper.learning_rate)
+        held = None
+        if bc.relabel in HOLDING and not self.learner.clones_every_pair:  # the held pairs SELECT stored
+            filled = jnp.arange(buf.capacity) < buf.size
+            held = filled & held_pairs(self.env, buf.obs, buf.goal, bc.select_radius)
         return bc_epoch(
-            self.policy, optimiser, pstate, opt_state, buf, key, bc.bc_steps, bc.batch_size, online, hyper.acting_step
+            self.policy,
+            optimiser,
+            pstate,
+            opt_state,
+            buf,
+            key,
+            bc.bc_steps,
+            bc.batch_size,
+            online,
+            hyper.acting_step,
+            held,
+            hyper.held_share,
         )
 
     def select(self, pstate, traj: Trajectory, horizon: jax.Array) -> Candidates:
