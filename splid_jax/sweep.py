@@ -83,7 +83,8 @@ def members(
 
 def member_configs(cfg: TrainConfig, grid: list[Member]) -> tuple[TrainConfig, list[TrainConfig]]:
     """The sweep's config (shapes for the largest H; the largest value of each varied field, so an
-    acting average is kept when any member has one) and each member's, in RUN_DIR/<member>."""
+    acting average is kept, and held pairs are told apart, when any member has one) and each member's,
+    in RUN_DIR/<member>."""
     largest = {field: max(dict(m.settings)[field] for m in grid) for field, _ in grid[0].settings}
     base = dataclasses.replace(cfg, horizon=max(m.horizon for m in grid), **largest)
     lanes = [

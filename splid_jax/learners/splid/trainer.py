@@ -20,7 +20,7 @@ from splid_jax.learners.base import Chunked
 from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.bc import bc_epoch
 from splid_jax.learners.imitation.candidates import Candidates
-from splid_jax.learners.imitation.config import HOLDING, ImitationConfig, select_modes
+from splid_jax.learners.imitation.config import ImitationConfig, select_modes
 from splid_jax.learners.imitation.explore import Seen, Trajectory, draws, hold_fingers, rollout
 from splid_jax.learners.splid.select import held_pairs, select
 from splid_jax.runtime.devices import ENVS
@@ -189,7 +189,7 @@ class Trainer(Chunked):
         bc = self.bc
         optimiser = optax.adam(hyper.learning_rate)
         held = None
-        if bc.relabel in HOLDING and not self.learner.clones_every_pair:  # the held pairs SELECT stored
+        if bc.held_share > 0 and not self.learner.clones_every_pair:  # the held pairs SELECT stored
             filled = jnp.arange(buf.capacity) < buf.size
             held = filled & held_pairs(self.env, buf.obs, buf.goal, bc.select_radius)
         return bc_epoch(
