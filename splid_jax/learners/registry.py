@@ -60,8 +60,8 @@ _IMITATION = dict(
 )
 # HER on the Fetch tasks runs as OpenAI Baselines: a cycle explores 2 episodes on each of 8 workers
 # (num_envs 16, with HerConfig's batch of 2048 = 8 x 256 averaged gradients) and an epoch of 50 cycles
-# is evaluated (eval_every 50). Push's 1,250 cycles are 20,000 episodes; Slide's and PickAndPlace's
-# 3,200 the 51,200 episodes of the SPLID runs there.
+# is evaluated (eval_every 50). Push's 1,250 cycles are 20,000 episodes; Slide's and PickAndPlace's 3,200 are
+# 51,200.
 _HER_FETCH = dict(num_envs=16, eval_every=50)
 # Steered exploration was chosen for SPLID; the baselines explore towards the goal, as their papers do
 _UNSTEERED = {task: {"explore_subgoal_reach": 0.0} for task in ("push", "slide", "pick_and_place")}
