@@ -125,11 +125,21 @@ def _placed_on_cpu() -> bool:
 
 
 def step_batch(env: GoalEnv, state: State, action: jax.Array) -> State:
-    """``env.step`` over a leading batch axis: one vmap, or on the CPU ``lax.map`` over slices."""
+    """``env.step`` over a leading batch axis: one vmap, or on the CPU ``lax.map`` over equal slices of at
+    most ``CPU_STEP_SLICE`` envs. Equal slices (the batch padded with copies of its last env, whose
+    steps are dropped) keep one batched copy of the step in the program, where a remainder slice would
+    be a second copy to trace and compile."""
     step = _traced_once(env)
-    if action.shape[0] <= CPU_STEP_SLICE or not _placed_on_cpu():
+    n = action.shape[0]
+    if n <= CPU_STEP_SLICE or not _placed_on_cpu():
         return jax.vmap(step)(state, action)
-    return jax.lax.map(lambda sa: step(*sa), (state, action), batch_size=CPU_STEP_SLICE)
+    slices = -(-n // CPU_STEP_SLICE)
+    size = -(-n // slices)
+    pad = slices * size - n
+    if pad:
+        state, action = jax.tree.map(lambda x: jnp.concatenate([x, jnp.repeat(x[-1:], pad, axis=0)]), (state, action))
+    out = jax.lax.map(lambda sa: step(*sa), (state, action), batch_size=size)
+    return jax.tree.map(lambda x: x[:n], out) if pad else out
 
 
 def mjx_substeps(model, data, phys, substeps: int):

@@ -71,3 +71,14 @@ def test_each_task_step_is_traced_once_whatever_the_batch_sizes():
         state = jax.eval_shape(jax.vmap(task.reset), jax.random.split(jax.random.PRNGKey(0), n))
         jax.make_jaxpr(lambda s, a, task=task: step_batch(task, s, a))(state, jnp.zeros((n, task.action_size)))
     assert _TRACES == [(env.action_size,)]  # the unbatched step, once
+
+
+def test_a_sliced_batch_holds_one_batched_step_however_many_envs():
+    env = _CountedPoint()
+    for n in (2 * CPU_STEP_SLICE, 2 * CPU_STEP_SLICE + 37):  # equal slices, and a batch padded to them
+        state = jax.eval_shape(jax.vmap(env.reset), jax.random.split(jax.random.PRNGKey(0), n))
+        with jax.default_device(jax.devices("cpu")[0]):
+            jaxpr = jax.make_jaxpr(lambda s, a: step_batch(env, s, a))(state, jnp.zeros((n, env.action_size)))
+        names = [e.primitive.name for e in jaxpr.jaxpr.eqns]
+        # the slices' scan holds the batched step; a remainder would call it once more beside the scan
+        assert names.count("scan") == 1 and not {"jit", "pjit"} & set(names), (n, names)
