@@ -30,6 +30,8 @@ from splid_jax.common.values import parse_overrides, typed_fields
 from splid_jax.config import TrainConfig
 from splid_jax.learners.her.config import HerConfig
 from splid_jax.learners.her.learner import HER
+from splid_jax.learners.imitation import relabel_buffer
+from splid_jax.learners.splid.select import held_pairs
 from splid_jax.learners.splid.trainer import Trainer
 
 LIFTED = 0.01  # m above where the object rests: a goal in the air, an object off the table
@@ -82,9 +84,8 @@ def goal_distances(env, buf) -> tuple[jax.Array, jax.Array, jax.Array]:
     """Each relabel-buffer pair's goal distance from the object (m), whether the pair is filled, and whether
     its goal is held (already where the object is)."""
     start = env.achieved_goal_start
-    filled = jnp.arange(buf.obs.shape[0]) < buf.size
     dist = jnp.linalg.norm(buf.goal - buf.obs[:, start : start + env.goal_size], axis=-1)
-    return dist, filled, dist < env.success_distance
+    return dist, relabel_buffer.filled(buf), held_pairs(env, buf.obs, buf.goal)
 
 
 def buffer_make_up(env, buf) -> dict:

@@ -49,6 +49,11 @@ def insert(buf: Buffer, obs: jax.Array, goal: jax.Array, action: jax.Array, mask
     return ring_buffer.insert(buf, {"obs": obs, "goal": goal, "action": action}, mask)
 
 
+def filled(buf: Buffer) -> jax.Array:
+    """[C] bool: the slots that hold a pair."""
+    return jnp.arange(buf.capacity) < buf.size
+
+
 class Held(NamedTuple):
     """The buffer's held-goal pairs as a list of slots, made once per epoch of BC steps."""
 

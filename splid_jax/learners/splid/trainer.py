@@ -190,8 +190,7 @@ class Trainer(Chunked):
         optimiser = optax.adam(hyper.learning_rate)
         held = None
         if bc.held_share > 0 and not self.learner.clones_every_pair:  # the held pairs SELECT stored
-            filled = jnp.arange(buf.capacity) < buf.size
-            held = filled & held_pairs(self.env, buf.obs, buf.goal, bc.select_radius)
+            held = relabel_buffer.filled(buf) & held_pairs(self.env, buf.obs, buf.goal, bc.select_radius)
         return bc_epoch(
             self.policy,
             optimiser,
