@@ -24,6 +24,7 @@ import jax.numpy as jnp
 from bench_splid import timed  # this folder's scripts share their timer
 
 from splid_jax.common.evaluation import evaluate
+from splid_jax.common.values import parse_overrides
 from splid_jax.config import TrainConfig
 from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.explore import draws, rollout
@@ -51,8 +52,8 @@ def shown(cfg: TrainConfig, *keys: str) -> dict:
 
 
 def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int, warm_chunks: int,
-                 chunk_only: bool = False) -> dict:  # fmt: skip
-    cfg = TrainConfig(env=env_name, env_options=env_options, run_dir="/tmp/stage-budget")
+                 chunk_only: bool = False, settings: dict | None = None) -> dict:  # fmt: skip
+    cfg = TrainConfig(env=env_name, env_options=env_options, run_dir="/tmp/stage-budget", **(settings or {}))
     env = make_env(cfg.env, **cfg.env_overrides())
     algo = make_algorithm(cfg, env)
     hyper = algo.hyper()
@@ -61,7 +62,7 @@ def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: i
     rows = {}
     rows["chunk"], state = chunk_row(algo, state, hyper, cfg, chunk_repeats, warm_chunks)
     if chunk_only:
-        return {"config": shown(cfg, "bc_steps"), "stages": rows}
+        return {"config": shown(cfg, "bc_steps", "select_lanes", *(settings or {})), "stages": rows}
     pstate, key = state.policy, jax.random.PRNGKey(1)
     sigma, horizon = hyper.sigma, hyper.horizon
 
@@ -144,6 +145,7 @@ def main() -> None:
     p.add_argument("--warm-chunks", type=int, default=1, help="chunks trained before timing (>= 1)")
     p.add_argument("--chunk-only", action="store_true", help="time the whole chunk alone, not each stage")
     p.add_argument("--label", default="default", help="the variant's name (e.g. its XLA flags)")
+    p.add_argument("--set", default="", help="SPLID's settings as FIELD=VALUE[,...], e.g. select_lanes=2")
     p.add_argument("--out", required=True)
     args = p.parse_args()
     result = {
@@ -157,7 +159,8 @@ def main() -> None:
     budgets = {"splid": splid_budget, "her": her_budget}
     for name in args.algos:
         sizes = (args.repeats, args.chunk_repeats, max(1, args.warm_chunks))
-        result[name] = budgets[name](args.env, args.env_options, *sizes, chunk_only=args.chunk_only)
+        extra = {"settings": parse_overrides(args.set, field="set")} if name == "splid" else {}
+        result[name] = budgets[name](args.env, args.env_options, *sizes, chunk_only=args.chunk_only, **extra)
         with open(args.out, "w") as fh:  # after each learner, so a cut call keeps what it measured
             json.dump(result, fh, indent=2)
         for stage, row in result[name]["stages"].items():

@@ -133,7 +133,10 @@ class TrainConfig:
         "0 picks pchid_every so that H is reached half-way through the run",
     )
     select_lanes: float = field(
-        None, "parallel SELECT replay lanes as a fraction of the T x N explored steps (speed only, never a verdict)"
+        None,
+        "parallel SELECT replay lanes per T x N explored steps, up to H (speed only, never a verdict): above 1 "
+        "an explored step's candidates replay side by side, fewer rounds where a GPU's batched step costs the "
+        "same at any width",
     )
     held_share: float = field(
         0.0,

@@ -67,6 +67,13 @@ def test_select_horizons_outside_their_range_name_the_field(fields):
         TrainConfig(env="point", **fields)
 
 
+@pytest.mark.parametrize("lanes", [0.0, 8.5])  # above the horizon 8: more lanes than candidates
+def test_select_lanes_outside_zero_to_the_horizon_names_the_field(lanes):
+    with pytest.raises(InvalidConfig, match="select_lanes"):
+        TrainConfig(env="point", select_lanes=lanes)
+    assert TrainConfig(env="point", select_lanes=8).select_lanes == 8
+
+
 @pytest.mark.parametrize(
     "fields", [{"held_share": -0.1}, {"held_share": 1.0}, {"held_share": 0.2, "relabel": "paper"}]
 )

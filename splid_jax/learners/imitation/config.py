@@ -77,7 +77,12 @@ class ImitationConfig:
             self.rest_horizon,
             f"0, or with relabel=rest an integer above the horizon {self.horizon}",
         )
-        check(0 < self.select_lanes <= 1, "select_lanes", self.select_lanes, "in (0, 1]")
+        check(
+            0 < self.select_lanes <= self.horizon,
+            "select_lanes",
+            self.select_lanes,
+            f"in (0, {self.horizon}] (times the explored steps; at most the horizon, one lane per candidate)",
+        )
         share = self.held_share
         check(0 <= share < 1, "held_share", share, "in [0, 1) (0: uniform sampling)")
         check(

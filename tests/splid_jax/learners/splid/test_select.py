@@ -146,7 +146,7 @@ def test_work_queue_gives_every_valid_candidate_the_verdict_of_its_own_replay(en
     the speed, never a verdict, and no lane steps past a verdict."""
     pstate = policy.init(jax.random.PRNGKey(3))
     traj = _explore(env, policy, pstate, jax.random.PRNGKey(1), jnp.float32(1.0))
-    results = [run_select(pstate, traj, lanes=lanes) for lanes in (0.02, 0.3, 1.0)]
+    results = [run_select(pstate, traj, lanes=lanes) for lanes in (0.02, 0.3, 1.0, 3.0)]
     c = results[0]
     starts = jax.tree_util.tree_map(lambda x: x.reshape((T * N,) + x.shape[2:]), traj.states)
     expected = np.asarray(c.valid & ~_each_alone(env, policy, pstate, starts, c.goal))
