@@ -218,6 +218,8 @@ def main(argv=None) -> int:
     if min(args.batch) < 1 or args.steps < 1 or args.repeats < 1:
         p.error("--batch, --steps and --repeats must be >= 1")
     print(f"device {jax.devices()[0]}, jax {jax.__version__}", flush=True)
+    if jax.default_backend() != "gpu":
+        print("no GPU: the trace holds no kernels, so only the wall times below mean anything", flush=True)
     results = []
     for batch in args.batch:
         results.append(profile_one(args.task, args.variant[1], batch, args.steps, args.repeats, args.top))
