@@ -14,6 +14,7 @@ variant (``--label`` names the variant in the output)."""
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 import sys
@@ -23,6 +24,7 @@ import jax
 import jax.numpy as jnp
 from bench_splid import timed  # this folder's scripts share their timer
 
+from splid_jax.common.errors import InvalidConfig
 from splid_jax.common.evaluation import evaluate
 from splid_jax.common.values import parse_overrides
 from splid_jax.config import TrainConfig
@@ -148,6 +150,14 @@ def main() -> None:
     p.add_argument("--set", default="", help="SPLID's settings as FIELD=VALUE[,...], e.g. select_lanes=2")
     p.add_argument("--out", required=True)
     args = p.parse_args()
+    try:  # a wrong setting fails here, naming it, before any compile
+        settings = parse_overrides(args.set, field="set")
+        unknown = sorted(set(settings) - {f.name for f in dataclasses.fields(TrainConfig)})
+        if unknown:
+            p.error(f"--set: {', '.join(unknown)} is no training setting (python -m splid_jax.train --help)")
+        TrainConfig(env=args.env, env_options=args.env_options, run_dir="/tmp/stage-budget", **settings)
+    except InvalidConfig as e:
+        p.error(str(e))
     result = {
         "label": args.label,
         "xla_flags": os.environ.get("XLA_FLAGS", ""),
@@ -159,7 +169,7 @@ def main() -> None:
     budgets = {"splid": splid_budget, "her": her_budget}
     for name in args.algos:
         sizes = (args.repeats, args.chunk_repeats, max(1, args.warm_chunks))
-        extra = {"settings": parse_overrides(args.set, field="set")} if name == "splid" else {}
+        extra = {"settings": settings} if name == "splid" else {}
         result[name] = budgets[name](args.env, args.env_options, *sizes, chunk_only=args.chunk_only, **extra)
         with open(args.out, "w") as fh:  # after each learner, so a cut call keeps what it measured
             json.dump(result, fh, indent=2)
