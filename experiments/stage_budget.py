@@ -14,7 +14,6 @@ variant (``--label`` names the variant in the output)."""
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import os
 import sys
@@ -26,8 +25,8 @@ from bench_splid import timed  # this folder's scripts share their timer
 
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.common.evaluation import evaluate
-from splid_jax.common.values import parse_overrides
 from splid_jax.config import TrainConfig
+from splid_jax.figures.settings import parse_sets
 from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.explore import draws, rollout
 from splid_jax.learners.registry import make_algorithm
@@ -147,14 +146,13 @@ def main() -> None:
     p.add_argument("--warm-chunks", type=int, default=1, help="chunks trained before timing (>= 1)")
     p.add_argument("--chunk-only", action="store_true", help="time the whole chunk alone, not each stage")
     p.add_argument("--label", default="default", help="the variant's name (e.g. its XLA flags)")
-    p.add_argument("--set", default="", help="SPLID's settings as FIELD=VALUE[,...], e.g. select_lanes=2")
+    p.add_argument(
+        "--set", action="append", default=[], help="a SPLID setting as FIELD=VALUE, e.g. select_lanes=2; repeatable"
+    )
     p.add_argument("--out", required=True)
     args = p.parse_args()
     try:  # a wrong setting fails here, naming it, before any compile
-        settings = parse_overrides(args.set, field="set")
-        unknown = sorted(set(settings) - {f.name for f in dataclasses.fields(TrainConfig)})
-        if unknown:
-            p.error(f"--set: {', '.join(unknown)} is no training setting (python -m splid_jax.train --help)")
+        settings = parse_sets(args.set, methods=())[None]
         TrainConfig(env=args.env, env_options=args.env_options, run_dir="/tmp/stage-budget", **settings)
     except InvalidConfig as e:
         p.error(str(e))

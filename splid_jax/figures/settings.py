@@ -44,7 +44,7 @@ def parse_sets(items: Sequence[str], methods: Sequence[str]) -> dict[str | None,
         method, dot, name = key.rpartition(".")
         name = name.replace("-", "_")
         if not eq or (dot and method not in methods):
-            allowed = "[METHOD.]FIELD=VALUE with METHOD among " + ", ".join(methods)
+            allowed = "[METHOD.]FIELD=VALUE with METHOD among " + ", ".join(methods) if methods else "FIELD=VALUE"
             raise InvalidConfig("set", item, allowed)
         check(
             name in types and name not in OWNED,
