@@ -234,6 +234,17 @@ def test_mean_and_standard_error_over_seeds(tmp_path):
     assert Path(png).read_bytes()[:8] == PNG_MAGIC
 
 
+def test_a_method_stopped_before_its_iterations_says_where_in_the_legend(tmp_path):
+    fake_figure(tmp_path, "fig6", {
+        "splid": [({"seed": 0, "algo": "splid", "iterations": 10}, [0.2, 0.6])],
+        "no-select": [({"seed": 0, "algo": "splid", "select": False, "iterations": 20}, [0.1, 0.3])],
+    })  # fmt: skip
+    record = json.loads((tmp_path / figures.SPEC).read_text())
+    fig = figures.draw(record, figures.load_series(str(tmp_path), record))
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert labels == ["SPLID (1 seed)", "SPLID without SELECT, stopped at 160 episodes (1 seed)"]
+
+
 def test_fig4_draws_one_series_per_h(tmp_path):
     members = [({"seed": s, "algo": "splid", "horizon": h}, list(np.linspace(0.1, h / 8, 3))) for h in (2, 8)
                for s in (0, 1)]  # fmt: skip
