@@ -49,6 +49,9 @@ from splid_jax.runtime.run_files import (
 from splid_jax.runtime.signals import Interrupted, SaveAbandoned, Signals
 
 COUNTER_KEYS = ("iteration", "episodes", "env_steps", "select_steps")
+# A chunk that runs this many times longer than the slowest before it, and at least LATE_FLOOR_S,
+# is reported on stderr as a possibly stalled device (the run goes on waiting).
+LATE_FACTOR, LATE_FLOOR_S = 10.0, 60.0
 
 
 class RunStopped(RuntimeError):
@@ -137,6 +140,20 @@ def run(
         split_envs = place.axis == devices.ENVS and place.count > 1
         algo = algo or signals.wait(lambda: registry.make_algorithm(cfg, env, place.mesh if split_envs else None))
         return _Loop(cfg, env, algo, members, place, signals, quiet, on_record).run(resume)
+
+
+def late_after(slowest_s: float) -> float | None:
+    """Seconds after which a chunk counts as late: none before one has finished, since the first
+    takes as long as it takes."""
+    return None if slowest_s <= 0 else max(LATE_FLOOR_S, LATE_FACTOR * slowest_s)
+
+
+def late_message(cfg: TrainConfig, iteration: int, ran_s: float, slowest_s: float) -> str:
+    span = f"{iteration + 1}-{iteration + cfg.eval_every}"
+    return (
+        f"{cfg.run_dir}: iterations {span} have run {ran_s:.0f} s, {ran_s / slowest_s:.0f}x the slowest chunk "
+        f"before them ({slowest_s:.1f} s); the device may be stalled (Ctrl-C saves iteration {iteration} and stops)"
+    )
 
 
 def warn_of_gap(path: str, kept: list[dict], step: int) -> None:
@@ -270,6 +287,10 @@ class _Loop:
         self.groups = groups
         return self.train(compiled, state, hyper, step or 0, select_steps, wall_before)
 
+    def warn_late(self, iteration: int, ran_s: float, slowest_s: float) -> None:
+        if self.writes:
+            print(f"warning: {late_message(self.cfg, iteration, ran_s, slowest_s)}", file=sys.stderr, flush=True)
+
     def check_state_fits(self, split: bool) -> None:
         """One member's state times the members a device holds, twice (the state and its update),
         against the device's memory: a grid of thousands is refused before anything is stacked or traced."""
@@ -328,12 +349,17 @@ class _Loop:
 
         if self.stacked:
             self.show(f"sweep: {len(lanes)} members in one program, {cfg.iterations} iterations")
-        last, chunks = [{}] * len(lanes), 0
+        last, chunks, slowest = [{}] * len(lanes), 0, 0.0
         try:
             while iteration < cfg.iterations:
                 t0 = time.perf_counter()
-                new_state, metrics = self.signals.wait(lambda s=state: jax.block_until_ready(compiled(s, hyper)))
+                new_state, metrics = self.signals.wait(
+                    lambda s=state: jax.block_until_ready(compiled(s, hyper)),
+                    late_after(slowest),
+                    lambda ran, i=iteration, was=slowest: self.warn_late(i, ran, was),
+                )
                 chunk_s = time.perf_counter() - t0
+                slowest = max(slowest, chunk_s)
                 metrics = jax.device_get(metrics)
                 finite = np.asarray(metrics.pop("finite")).reshape(-1)
                 done = iteration + cfg.eval_every

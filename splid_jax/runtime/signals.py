@@ -75,14 +75,22 @@ class Signals:
                 raise Interrupted(self.signum)
         self.check()
 
-    def wait(self, fn: Callable[[], Any]) -> Any:
+    def wait(
+        self, fn: Callable[[], Any], late_after: float | None = None, on_late: Callable[[float], None] | None = None
+    ) -> Any:
         """``fn()`` in a daemon thread; raises ``Interrupted`` as soon as a signal came (the thread is
-        left to finish or to die with the process)."""
+        left to finish or to die with the process). Once ``fn`` has run ``late_after`` seconds,
+        ``on_late(seconds)`` is called, once: a program stuck on its device says so instead of
+        leaving a silent process."""
         self.check()
+        start = time.monotonic()
         thread, box = _started(fn)
         while thread.is_alive():
             thread.join(0.05)
             self.check()
+            if late_after is not None and on_late is not None and time.monotonic() - start > late_after:
+                on_late(time.monotonic() - start)
+                late_after = None
         return _result(box)
 
     def finish(self, fn: Callable[[], Any], grace: float = GRACE_S) -> Any:

@@ -32,6 +32,8 @@ class Toy:
     cfg: TrainConfig
     nan_at: int = -1
     sleep: float = 0.0  # seconds each chunk waits in a host callback, to be long enough to interrupt
+    hold: threading.Event | None = None  # the chunk ending at iteration ``hold_at`` waits for it (at most 30 s)
+    hold_at: int = -1
     name = "toy"
 
     def init(self, key):
@@ -49,6 +51,10 @@ class Toy:
             return {**s, "w": w, "key": key, "iteration": s["iteration"] + 1}, jnp.int32(7)
 
         s, steps = jax.lax.scan(one, state, None, length=self.cfg.eval_every)
+        if self.hold is not None:
+            held = lambda w, i: (self.hold.wait(30) if i == self.hold_at else None, w)[1]  # noqa: E731
+            s = {**s, "w": jax.pure_callback(held, jax.ShapeDtypeStruct(s["w"].shape, jnp.float32), s["w"],
+                                             s["iteration"])}  # fmt: skip
         if self.sleep:
             pause = lambda w: (time.sleep(self.sleep), w)[1]  # noqa: E731
             s = {**s, "w": jax.pure_callback(pause, jax.ShapeDtypeStruct(s["w"].shape, jnp.float32), s["w"])}
@@ -230,6 +236,25 @@ def test_a_signal_during_a_chunk_saves_the_newest_whole_state(tmp_path):
     assert info.value.exit_code == 143
     step = checkpoint.latest_step(cfg.run_dir)
     assert step == records(cfg.run_dir)[-1]["iteration"] >= 4
+
+
+def test_a_chunk_far_slower_than_those_before_it_is_reported_and_waited_for(tmp_path, monkeypatch, capsys):
+    cfg = config(tmp_path, checkpoint_every=0)
+    warned = threading.Event()
+    monkeypatch.setattr(loop, "late_after", lambda slowest: None if slowest <= 0 else 0.0)
+    warn = loop._Loop.warn_late
+    monkeypatch.setattr(loop._Loop, "warn_late", lambda self, *a: (warn(self, *a), warned.set()))
+    run(cfg, hold=warned, hold_at=4)  # the second chunk ends only once it has been reported
+    err = capsys.readouterr().err
+    assert f"warning: {cfg.run_dir}: iterations 3-4 have run" in err
+    assert "the device may be stalled (Ctrl-C saves iteration 2 and stops)" in err
+    assert [r["iteration"] for r in records(cfg.run_dir)] == [2, 4, 6]
+
+
+def test_a_chunk_is_late_at_ten_times_the_slowest_before_it_and_never_under_a_minute():
+    assert loop.late_after(0.0) is None  # the first chunk: nothing to compare with
+    assert loop.late_after(1.5) == 60.0
+    assert loop.late_after(12.0) == 120.0
 
 
 def test_signals_stop_a_wait_at_once():

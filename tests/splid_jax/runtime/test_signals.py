@@ -85,3 +85,21 @@ def test_two_signals_end_a_run_whose_save_hangs_keeping_the_last_whole_checkpoin
     assert proc.returncode == 143 and "Traceback" not in err, err
     assert "while saving iteration 10, not waited for: the last whole checkpoint, iteration 5 is kept" in out
     assert checkpoint.latest_step(run_dir) == 5
+
+
+def test_a_wait_past_its_lateness_reports_once_and_still_returns_the_result():
+    reported, late = [], threading.Event()
+
+    def on_late(seconds):
+        reported.append(seconds)
+        late.set()
+
+    s = Signals()
+    assert s.wait(lambda: (late.wait(30), "done")[1], late_after=0.0, on_late=on_late) == "done"
+    assert len(reported) == 1 and reported[0] >= 0.0
+
+
+def test_a_wait_within_its_lateness_reports_nothing():
+    reported = []
+    assert Signals().wait(lambda: "done", late_after=3600.0, on_late=reported.append) == "done"
+    assert reported == []
