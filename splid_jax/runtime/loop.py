@@ -89,6 +89,19 @@ def _lane_hyper(algo: Algorithm, base: TrainConfig, lane: TrainConfig) -> Any:
     return algo.hyper(lane)
 
 
+def initial_state(init: Callable[[jax.Array], Any], keys: jax.Array, stacked: bool, one_by_one: bool) -> Any:
+    """``init`` of each key, stacked along a leading axis for a sweep. ``one_by_one`` builds each member
+    alone and stacks them, for XLA:CPU: jaxlib 0.10.2 never finishes the vmapped init of five Push members
+    (each member alone, or four together, takes a second). A member's state depends on its key alone, so
+    both ways give the same arrays."""
+    if not stacked:
+        return jax.jit(init)(keys)
+    if not one_by_one:
+        return jax.jit(jax.vmap(init))(keys)
+    one = jax.jit(init)
+    return jax.tree.map(lambda *x: jnp.stack(x), *[one(k) for k in keys])
+
+
 def _canonical(tree, sharding):
     """Strongly typed arrays placed as ``sharding`` says, whether they come from init or a checkpoint,
     so the compiled chunk takes a resumed state as it takes a fresh one."""
@@ -273,7 +286,8 @@ class _Loop:
         if resume:
             state, select_steps, wall_before = self.restore(like)
         else:
-            state = _canonical(self.signals.wait(lambda: jax.jit(init)(keys)), sharding)
+            first = lambda: initial_state(algo.init, keys, self.stacked, self.device.platform == "cpu")  # noqa: E731
+            state = _canonical(self.signals.wait(first), sharding)
             state = state if groups is None else groups.split(state)
             select_steps, wall_before = [0] * len(self.lanes), 0.0
             for lane in self.lanes if self.writes else ():

@@ -120,6 +120,36 @@ def test_one_schema_for_a_run_and_a_sweep(tmp_path):
     assert (saved["sigma"], saved["seed"]) == (0.5, 1)
 
 
+def test_a_cpu_sweep_initialises_its_members_one_by_one(tmp_path, monkeypatch):
+    seen = []
+    real = loop.initial_state
+    monkeypatch.setattr(loop, "initial_state", lambda *a: (seen.append(a[2:]), real(*a))[1])
+    run(config(tmp_path), members=sweep_lanes(config(tmp_path)))
+    assert seen == [(True, True)]  # stacked, one by one: the test machine is a CPU
+
+
+def test_members_built_one_by_one_equal_the_vmapped_init():
+    from splid_jax.learners.registry import make_algorithm
+
+    cfg = TrainConfig(env="point", run_dir="unused")
+    algo = make_algorithm(cfg, ENV)
+    keys = jnp.stack([jax.random.PRNGKey(s) for s in (0, 1, 7)])
+    one_by_one = loop.initial_state(algo.init, keys, True, True)
+    vmapped = loop.initial_state(algo.init, keys, True, False)
+    assert jax.tree.all(jax.tree.map(lambda a, b: bool(jnp.array_equal(a, b)), one_by_one, vmapped))
+
+
+def test_five_push_members_are_initialised_on_the_cpu():
+    """XLA:CPU (jaxlib 0.10.2) hung on the vmapped init of five Push members in 8 of 10 tries."""
+    from splid_jax.learners.registry import make_algorithm
+
+    cfg = TrainConfig(env="push", run_dir="unused")
+    algo = make_algorithm(cfg, envs.make("push"))
+    keys = jnp.stack([jax.random.PRNGKey(s) for s in range(5)])
+    state = jax.block_until_ready(loop.initial_state(algo.init, keys, True, True))
+    assert state.iteration.shape == (5,)
+
+
 @pytest.mark.parametrize("sweep", [False, True], ids=["run", "sweep"])
 def test_resume_continues_bit_for_bit_and_compiles_the_chunk_once(tmp_path, caplog, sweep):
     whole, part = config(tmp_path, "whole"), config(tmp_path, "part", iterations=2)
