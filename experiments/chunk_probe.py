@@ -32,8 +32,10 @@ from splid_jax.common.subgoals import steered  # noqa: E402
 from splid_jax.config import TrainConfig  # noqa: E402
 from splid_jax.learners.imitation.explore import draws, hold_fingers, rollout  # noqa: E402
 from splid_jax.learners.registry import make_algorithm  # noqa: E402
+from splid_jax.rollout import load_config  # noqa: E402
 from splid_jax.runtime import checkpoint, loop  # noqa: E402
 from splid_jax.runtime.run_files import SWEEP  # noqa: E402
+from splid_jax.sweep import resume_configs  # noqa: E402
 
 
 class Stalled(RuntimeError):
@@ -42,17 +44,9 @@ class Stalled(RuntimeError):
 
 def configs(run_dir: str) -> tuple[TrainConfig, list[TrainConfig] | None]:
     """The run's config and, for a sweep, its members'."""
-    sweep = os.path.join(run_dir, SWEEP)
-    if os.path.isfile(sweep):
-        with open(sweep) as fh:
-            sw = json.load(fh)
-        base = TrainConfig.from_json({**sw["config"], "run_dir": run_dir})
-        members = [TrainConfig.from_json({**m, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in sw["members"]]
-        return base, members
-    with open(os.path.join(run_dir, "config.json")) as fh:
-        raw = json.load(fh)
-    raw.pop("devices", None)
-    return TrainConfig.from_json({**raw, "run_dir": run_dir}), None
+    if os.path.isfile(os.path.join(run_dir, SWEEP)):
+        return resume_configs(run_dir, {})
+    return load_config(run_dir), None
 
 
 def watched(name: str, limit: float, log: list[dict], fn, *args):
