@@ -148,7 +148,16 @@ class TrainConfig:
     )
     buffer_size: int = field(None, "relabel buffer capacity (FIFO)")
     batch_size: int = field(None, "behaviour-cloning minibatch size")
-    bc_steps: int = field(None, "behaviour-cloning gradient steps per iteration")
+    bc_steps: int = field(None, "behaviour-cloning gradient steps per iteration (with bc_reuse: at most)")
+    bc_reuse: float = field(
+        0.0,
+        "cloning learners: behaviour-cloning samples per newly stored pair, so an iteration runs ceil(bc_reuse x new "
+        "pairs / batch_size) steps, at least 1 and at most bc_steps; SELECT keeps fewer pairs as the policy improves, "
+        "and a fixed step count then trains ever longer on the same pairs (the authors' code: 30 samples per new "
+        "pair). 0: bc_steps every iteration",
+        recorded_when_set=True,
+        unrecorded=0.0,
+    )
     learning_rate: float = field(None, "Adam learning rate of the behaviour-cloning step")
     policy_ema: float = field(
         None,

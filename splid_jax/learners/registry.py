@@ -56,6 +56,7 @@ _IMITATION = dict(
         "gripper_hold",
         "explore_subgoal_reach",
         "held_share",
+        "bc_reuse",
     ),
 )
 # HER on the Fetch tasks runs as OpenAI Baselines: a cycle explores 2 episodes on each of 8 workers

@@ -57,19 +57,27 @@ def bc_epoch(
     acting_step: float | jax.Array = 1.0,
     held: jax.Array | None = None,
     held_share: float | jax.Array = 0.0,
+    active: jax.Array | None = None,
 ):
     """``num_steps`` minibatch steps from the buffer; returns (pstate, opt_state, online, mean loss).
-    ``held`` ([C] bool, the held-goal pairs) lets ``held_share`` of each batch come from them."""
+    ``held`` ([C] bool, the held-goal pairs) lets ``held_share`` of each batch come from them. With
+    ``active`` ([] int, traced) only the first ``active`` steps update: the rest are no-ops, so the shapes
+    stay static and each step draws the minibatch it draws with all steps taken."""
     weight = (buf.size > 0).astype(jnp.float32)
     slots = None if held is None else relabel_buffer.held_slots(held)
+    taken = jnp.ones((num_steps,), bool) if active is None else jnp.arange(num_steps) < active
 
-    def one(carry, k):
+    def one(carry, step):
         ps, os, on = carry
+        k, take = step
         batch = relabel_buffer.sample(buf, k, batch_size, slots, held_share)
-        ps, os, on, loss = bc_step(policy, optimiser, ps, os, batch, weight, on, acting_step)
+        ps, os, on, loss = bc_step(policy, optimiser, ps, os, batch, weight * take, on, acting_step)
         return (ps, os, on), loss
 
     (pstate, opt_state, online), losses = jax.lax.scan(
-        one, (pstate, opt_state, online), jax.random.split(key, num_steps)
+        one, (pstate, opt_state, online), (jax.random.split(key, num_steps), taken)
     )
-    return pstate, opt_state, online, jnp.mean(losses)
+    if active is None:
+        return pstate, opt_state, online, jnp.mean(losses)
+    some = jnp.sum(jnp.where(taken, losses, 0.0)) / jnp.maximum(active, 1)
+    return pstate, opt_state, online, jnp.where(active >= num_steps, jnp.mean(losses), some)

@@ -41,6 +41,7 @@ class ImitationConfig:
     buffer_size: int
     batch_size: int
     bc_steps: int
+    bc_reuse: float
     learning_rate: float
     policy_ema: float
     hidden: tuple[int, ...]
@@ -94,6 +95,7 @@ class ImitationConfig:
         check(self.buffer_size >= 1, "buffer_size", self.buffer_size, "an integer >= 1")
         check(self.batch_size >= 1, "batch_size", self.batch_size, "an integer >= 1")
         check(self.bc_steps >= 1, "bc_steps", self.bc_steps, "an integer >= 1 (no step leaves the loss undefined)")
+        check(self.bc_reuse >= 0, "bc_reuse", self.bc_reuse, ">= 0 (0: bc_steps every iteration)")
         check(self.learning_rate > 0, "learning_rate", self.learning_rate, "> 0")
         check(0 <= self.policy_ema < 1, "policy_ema", self.policy_ema, "in [0, 1)")
         check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "hidden", self.hidden, "one or more widths >= 1")

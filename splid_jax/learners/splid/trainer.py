@@ -50,6 +50,7 @@ class Hyper:
     gripper_hold: jax.Array  # [] int32, steps the fingers' noise is held (tasks that move them)
     explore_reach: jax.Array  # [] float32, exploration's subgoal reach (inf: the goal itself)
     held_share: jax.Array  # [] float32, the share of BC's batches drawn from the held-goal pairs
+    bc_reuse: jax.Array  # [] float32, BC samples per new pair (0: the configured steps every iteration)
 
 
 class Trainer(Chunked):
@@ -100,6 +101,7 @@ class Trainer(Chunked):
             gripper_hold=jnp.int32(bc.gripper_hold),
             explore_reach=traced_reach(bc.explore_subgoal_reach),
             held_share=jnp.float32(bc.held_share),
+            bc_reuse=jnp.float32(bc.bc_reuse),
         )
 
     def init(self, key: jax.Array) -> TrainState:
@@ -139,13 +141,16 @@ class Trainer(Chunked):
             cands = gcsl.relabel(env, seen, bc.gcsl_relabel, k_relabel)
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
         pstate = policy.update_normaliser(ts.policy, seen.obs, seen.achieved[:-1], ~seen.invalid[:-1])
-        pstate, opt_state, online, loss = self.clone(pstate, ts.opt_state, ts.online, buf, k_bc, hyper)
+        stored = jnp.sum(cands.accept, dtype=jnp.int32)
+        steps = self.bc_steps_for(stored, hyper)
+        pstate, opt_state, online, loss = self.clone(pstate, ts.opt_state, ts.online, buf, k_bc, hyper, steps)
         metrics = {
             "select_pairs": jnp.sum(cands.valid, dtype=jnp.int32),
             "select_held": jnp.sum(cands.valid & cands.held, dtype=jnp.int32),
             "select_held_accepted": jnp.sum(cands.accept & cands.held, dtype=jnp.int32),
-            "select_accepted": jnp.sum(cands.accept, dtype=jnp.int32),
+            "select_accepted": stored,
             "select_steps": cands.replay_steps,
+            "bc_steps": steps,
             "bc_loss": loss,
             "explore_success": jnp.mean(jnp.any(seen.success, axis=0)),
         }
@@ -183,9 +188,17 @@ class Trainer(Chunked):
             return traj.seen(), None
         return traj.seen(), self.select(pstate, traj, horizon)
 
-    def clone(self, pstate, opt_state, online, buf: relabel_buffer.Buffer, key, hyper: Hyper):
-        """Behaviour cloning on the buffer, at ``hyper``'s rate and acting average: the one place the
-        settings become BC's arguments. Returns (pstate, opt_state, online, mean loss)."""
+    def bc_steps_for(self, stored: jax.Array, hyper: Hyper) -> jax.Array:
+        """This iteration's BC steps: with ``bc_reuse``, enough minibatches to draw each newly stored pair
+        that many times on average, in [1, bc_steps]; otherwise bc_steps."""
+        bc = self.bc
+        wanted = jnp.ceil(hyper.bc_reuse * stored.astype(jnp.float32) / bc.batch_size).astype(jnp.int32)
+        return jnp.where(hyper.bc_reuse > 0, jnp.clip(wanted, 1, bc.bc_steps), bc.bc_steps)
+
+    def clone(self, pstate, opt_state, online, buf: relabel_buffer.Buffer, key, hyper: Hyper, steps=None):
+        """Behaviour cloning on the buffer, at ``hyper``'s rate and acting average, ``steps`` of the
+        configured bc_steps (all when None): the one place the settings become BC's arguments. Returns
+        (pstate, opt_state, online, mean loss)."""
         bc = self.bc
         optimiser = optax.adam(hyper.learning_rate)
         held = None
@@ -204,6 +217,7 @@ class Trainer(Chunked):
             hyper.acting_step,
             held,
             hyper.held_share,
+            steps,
         )
 
     def select(self, pstate, traj: Trajectory, horizon: jax.Array) -> Candidates:
@@ -250,6 +264,7 @@ class Trainer(Chunked):
             sigma=self.sigma_at(ts.iteration - 1, hyper),
             select_steps=per_iter["select_steps"],  # [eval_every]: summed on the host, where ints do not overflow
             bc_loss=per_iter["bc_loss"][-1],
+            bc_steps=jnp.mean(per_iter["bc_steps"].astype(jnp.float32)),
             explore_success=jnp.mean(per_iter["explore_success"]),
             buffer_size=ts.buffer.size,
         )

@@ -65,3 +65,29 @@ def test_normaliser_ignores_rows_flagged_invalid():
     chex.assert_trees_all_close(new.normaliser.mean, clean.normaliser.mean)
     chex.assert_trees_all_close(new.normaliser.std, clean.normaliser.std)
     assert bool(jnp.all(jnp.isfinite(policy.act(new, obs[:1], goal[:1]))))
+
+
+def _filled_buffer(batch):
+    buf = relabel_buffer.init(64, 2, 2, 2)
+    return relabel_buffer.insert(buf, *batch, jnp.ones((64,), bool))
+
+
+def test_an_epoch_of_active_steps_takes_those_steps_and_leaves_the_rest_as_no_ops():
+    policy, pstate, batch = _setup()
+    opt = optax.adam(1e-2)
+    buf, key = _filled_buffer(batch), jax.random.PRNGKey(3)
+    start = opt.init(pstate.params)
+    epoch = jax.jit(lambda active: bc_epoch(policy, opt, pstate, start, buf, key, 6, 8, active=active))
+    # every step active: the epoch without a count, bit for bit
+    whole = bc_epoch(policy, opt, pstate, opt.init(pstate.params), buf, key, 6, 8)
+    chex.assert_trees_all_equal(epoch(jnp.int32(6))[:2], whole[:2])
+    # two active: the first two of the six steps' minibatches, and Adam counts two steps
+    ps, os = pstate, opt.init(pstate.params)
+    losses = []
+    for k in jax.random.split(key, 6)[:2]:
+        ps, os, _, loss = bc_step(policy, opt, ps, os, relabel_buffer.sample(buf, k, 8), 1.0)
+        losses.append(loss)
+    two = epoch(jnp.int32(2))
+    chex.assert_trees_all_close(two[0].params, ps.params, rtol=1e-6, atol=1e-7)
+    assert int(two[1][0].count) == 2
+    assert abs(float(two[3]) - float(jnp.mean(jnp.stack(losses)))) < 1e-6

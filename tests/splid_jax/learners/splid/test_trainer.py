@@ -136,3 +136,16 @@ def test_a_held_share_clones_the_held_pairs_that_select_stored():
     on_held = float(bc_loss(params, trainer.policy, ts.policy, obs[7:8], goal[7:8], action[7:8]))
     np.testing.assert_allclose(loss(1.0), on_held, rtol=1e-5)
     assert abs(loss(0.0) - on_held) > 1e-3
+
+
+def test_bc_reuse_sets_the_steps_by_the_pairs_stored_and_is_a_traced_setting(trainer):
+    """bc_reuse x new pairs / batch_size minibatches, in [1, bc_steps]; 0 keeps bc_steps (50 here)."""
+    iteration = jax.jit(trainer.iteration)
+    state = trainer.init(jax.random.PRNGKey(2))
+    for reuse in (0.0, 0.5, 1e-6, 1e6):
+        _, m = iteration(state, trainer.hyper().replace(bc_reuse=jnp.float32(reuse)))
+        stored = int(m["select_accepted"])
+        want = 50 if reuse == 0 else min(50, max(1, int(np.ceil(reuse * stored / 128))))
+        assert int(m["bc_steps"]) == want, (reuse, stored)
+    assert 1 < int(np.ceil(0.5 * stored / 128)) < 50  # the 0.5 case falls inside the bounds
+    assert iteration._cache_size() == 1
