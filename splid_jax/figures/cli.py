@@ -102,6 +102,12 @@ def build_parser() -> Parser:
         "value then a sweep of its own shapes), on other machines or in other calls, into --out, a new "
         "directory, and draw them as one figure; the parts are copied, not moved",
     )
+    parser.add_argument(
+        "--replace",
+        action="store_true",
+        help="with fig3's --merge: a method in several parts is taken from the last of them (a method run "
+        "again, joined with an earlier merged figure)",
+    )
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_compile_cache_flag(parser)
     return parser
@@ -122,10 +128,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     use_compile_cache(ns.compile_cache)
     try:
         with lock.hold(out, field="out"):  # one process per figure directory
+            check(bool(ns.merge) or not ns.replace, "replace", True, "given with --merge")
             if ns.merge:
                 check(not (ns.replot or ns.resume), "merge", " ".join(ns.merge), "given without --replot or --resume")
                 check(ns.out is not None, "out", None, "the new directory --merge joins the parts into")
-                merge(out, ns.merge, ns.figure, shlex.join(["python", "-m", "splid_jax.figures", *argv]))
+                merge(out, ns.merge, ns.figure, shlex.join(["python", "-m", "splid_jax.figures", *argv]), ns.replace)
             elif ns.replot or ns.resume:
                 check(not (ns.replot and ns.resume), "replot", True, "given without --resume")
                 mode = "resume" if ns.resume else "replot"

@@ -336,6 +336,34 @@ def test_merge_joins_subsets_trained_apart_into_one_figure(tmp_path, capsys):
     assert {r["method"] for r in rows(out / "fig3-point.csv")} == {"splid", "gcsl", "her"}
 
 
+def test_merge_replaces_a_method_of_an_earlier_merged_figure_and_keeps_each_runs_command(tmp_path, capsys):
+    a, b, c, first, out = (tmp_path / n for n in ("a", "b", "c", "first", "out"))
+    fake_figure(a, "fig3", {"her": [({"seed": 0, "algo": "her"}, [0.2, 0.4])]})
+    fake_figure(b, "fig3", {"splid": [({"seed": 0, "algo": "splid"}, [0.5, 0.6])]})
+    record = fake_figure(c, "fig3", {"splid": [({"seed": 0, "algo": "splid"}, [0.7, 0.9])]})
+    (c / figures.SPEC).write_text(json.dumps({**record, "command": "the rerun", "device": "GPU", "date": "2026-11-27"}))
+    assert figures.main(["fig3", "--merge", str(a), str(b), "--out", str(first), "--quiet"]) == 0
+    # a method in two parts is refused unless the last part's run is asked for
+    assert figures.main(["fig3", "--merge", str(first), str(c), "--out", str(out), "--quiet"]) == 2
+    assert "--replace" in capsys.readouterr().err and not out.exists()
+    assert figures.main(["fig3", "--merge", str(first), str(c), "--out", str(out), "--quiet", "--replace"]) == 0
+    merged = json.loads((out / "figure.json").read_text())
+    assert merged["methods"] == ["splid", "her"]
+    assert [(p["command"], p["methods"]) for p in merged["parts"]] == [
+        ("python -m splid_jax.figures", ["her"]),  # the first merge's own part, not the first merge's command
+        ("the rerun", ["splid"]),
+    ]
+    assert merged["device"] == "CPU + GPU" and merged["date"] == "2026-11-23 + 2026-11-27"
+    splid = {r["episodes"]: r for r in rows(out / "fig3-point.csv") if r["method"] == "splid"}
+    assert [float(splid[k]["eval_success_mean"]) for k in sorted(splid, key=int)] == pytest.approx([0.7, 0.9])
+
+
+def test_replace_without_merge_is_refused_in_one_line(tmp_path, capsys):
+    assert figures.main(["fig3", "--replace", "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "invalid replace=" in err
+
+
 @pytest.mark.parametrize("clash", ["method", "budget", "figure"])
 def test_merge_refuses_parts_that_are_not_one_figure(tmp_path, capsys, clash):
     a, b, out = tmp_path / "a", tmp_path / "b", tmp_path / "out"
