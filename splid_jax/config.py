@@ -147,6 +147,14 @@ class TrainConfig:
         unrecorded=0.0,
     )
     buffer_size: int = field(None, "relabel buffer capacity (FIFO)")
+    buffer_window: int = field(
+        0,
+        "cloning learners: behaviour cloning draws from the newest buffer_window pairs alone, as a FIFO buffer of "
+        "that capacity would hold them; a traced setting, so one sweep compares buffer capacities up to "
+        "buffer_size (0: the whole buffer)",
+        recorded_when_set=True,
+        unrecorded=0,
+    )
     batch_size: int = field(None, "behaviour-cloning minibatch size")
     bc_steps: int = field(None, "behaviour-cloning gradient steps per iteration (with bc_reuse: at most)")
     bc_reuse: float = field(

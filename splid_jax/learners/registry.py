@@ -57,6 +57,7 @@ _IMITATION = dict(
         "explore_subgoal_reach",
         "held_share",
         "bc_reuse",
+        "buffer_window",
     ),
 )
 # HER on the Fetch tasks runs as OpenAI Baselines: a cycle explores 2 episodes on each of 8 workers

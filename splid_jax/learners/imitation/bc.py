@@ -58,11 +58,13 @@ def bc_epoch(
     held: jax.Array | None = None,
     held_share: float | jax.Array = 0.0,
     active: jax.Array | None = None,
+    window: jax.Array | None = None,
 ):
     """``num_steps`` minibatch steps from the buffer; returns (pstate, opt_state, online, mean loss).
     ``held`` ([C] bool, the held-goal pairs) lets ``held_share`` of each batch come from them. With
     ``active`` ([] int, traced) only the first ``active`` steps update: the rest are no-ops, so the shapes
-    stay static and each step draws the minibatch it draws with all steps taken."""
+    stay static and each step draws the minibatch it draws with all steps taken. ``window``: batches come
+    from the newest ``window`` pairs (``relabel_buffer.sample``)."""
     weight = (buf.size > 0).astype(jnp.float32)
     slots = None if held is None else relabel_buffer.held_slots(held)
     taken = jnp.ones((num_steps,), bool) if active is None else jnp.arange(num_steps) < active
@@ -70,7 +72,7 @@ def bc_epoch(
     def one(carry, step):
         ps, os, on = carry
         k, take = step
-        batch = relabel_buffer.sample(buf, k, batch_size, slots, held_share)
+        batch = relabel_buffer.sample(buf, k, batch_size, slots, held_share, window)
         ps, os, on, loss = bc_step(policy, optimiser, ps, os, batch, weight * take, on, acting_step)
         return (ps, os, on), loss
 

@@ -39,6 +39,7 @@ class ImitationConfig:
     select_lanes: float
     held_share: float
     buffer_size: int
+    buffer_window: int
     batch_size: int
     bc_steps: int
     bc_reuse: float
@@ -93,6 +94,9 @@ class ImitationConfig:
             f"0 with relabel={self.relabel}, which adds no held goals (they come with " + ", ".join(HOLDING) + ")",
         )
         check(self.buffer_size >= 1, "buffer_size", self.buffer_size, "an integer >= 1")
+        window = self.buffer_window
+        allowed = f"in [0, {self.buffer_size}] (buffer_size; 0: the whole buffer)"
+        check(0 <= window <= self.buffer_size, "buffer_window", window, allowed)
         check(self.batch_size >= 1, "batch_size", self.batch_size, "an integer >= 1")
         check(self.bc_steps >= 1, "bc_steps", self.bc_steps, "an integer >= 1 (no step leaves the loss undefined)")
         check(self.bc_reuse >= 0, "bc_reuse", self.bc_reuse, ">= 0 (0: bc_steps every iteration)")

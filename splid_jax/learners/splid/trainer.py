@@ -51,6 +51,7 @@ class Hyper:
     explore_reach: jax.Array  # [] float32, exploration's subgoal reach (inf: the goal itself)
     held_share: jax.Array  # [] float32, the share of BC's batches drawn from the held-goal pairs
     bc_reuse: jax.Array  # [] float32, BC samples per new pair (0: the configured steps every iteration)
+    buffer_window: jax.Array  # [] int32, BC draws from the newest this many pairs (the capacity: all)
 
 
 class Trainer(Chunked):
@@ -102,6 +103,7 @@ class Trainer(Chunked):
             explore_reach=traced_reach(bc.explore_subgoal_reach),
             held_share=jnp.float32(bc.held_share),
             bc_reuse=jnp.float32(bc.bc_reuse),
+            buffer_window=jnp.int32(bc.buffer_window or self.bc.buffer_size),
         )
 
     def init(self, key: jax.Array) -> TrainState:
@@ -203,7 +205,9 @@ class Trainer(Chunked):
         optimiser = optax.adam(hyper.learning_rate)
         held = None
         if bc.held_share > 0 and not self.learner.clones_every_pair:  # the held pairs SELECT stored
-            held = relabel_buffer.filled(buf) & held_pairs(self.env, buf.obs, buf.goal, bc.select_radius)
+            held = relabel_buffer.newest(buf, hyper.buffer_window) & held_pairs(
+                self.env, buf.obs, buf.goal, bc.select_radius
+            )
         return bc_epoch(
             self.policy,
             optimiser,
@@ -218,6 +222,7 @@ class Trainer(Chunked):
             held,
             hyper.held_share,
             steps,
+            hyper.buffer_window,
         )
 
     def select(self, pstate, traj: Trajectory, horizon: jax.Array) -> Candidates:

@@ -58,7 +58,7 @@ def test_only_the_cloning_learners_split_a_run_and_sweep_their_settings():
     splits = {name for name, x in registry.LEARNERS.items() if x.splits_envs}
     assert splits == {"splid", "gcsl", "pchid"}
     traced = ("sigma", "horizon", "horizon_end", "sigma_end", "learning_rate", "policy_ema", "gripper_hold")
-    traced += ("explore_subgoal_reach", "held_share", "bc_reuse")
+    traced += ("explore_subgoal_reach", "held_share", "bc_reuse", "buffer_window")
     assert all(registry.get(n).sweeps == (traced if n in splits else ()) for n in registry.names())
     assert [n for n, x in registry.LEARNERS.items() if x.grows_horizon] == ["pchid"]
     assert [n for n, x in registry.LEARNERS.items() if x.clones_every_pair] == ["gcsl"]

@@ -48,6 +48,26 @@ def test_sampling_draws_only_filled_rows_uniformly():
     np.testing.assert_array_equal(goal - obs, 100)  # rows stay aligned
 
 
+def test_a_window_draws_the_newest_pairs_as_a_fifo_of_that_capacity_holds_them():
+    buf = relabel_buffer.init(8, 1, 1, 1)
+    buf = relabel_buffer.insert(buf, *_rows(np.arange(1, 12)), jnp.ones(11, bool))  # 4..11 kept, 9..11 newest
+    obs, goal, _ = relabel_buffer.sample(buf, jax.random.PRNGKey(0), 3000, window=3)
+    values, counts = np.unique(np.asarray(obs[:, 0]), return_counts=True)
+    np.testing.assert_array_equal(values, [9, 10, 11])
+    assert counts.min() > 850  # about 1000 each
+    np.testing.assert_array_equal(goal - obs, 100)
+    np.testing.assert_array_equal(buf.obs[relabel_buffer.newest(buf, 3), 0], [9, 10, 11])
+    # a window holding every pair draws exactly the whole buffer's batch
+    key = jax.random.PRNGKey(4)
+    for window in (8, 100):
+        chex.assert_trees_all_equal(
+            relabel_buffer.sample(buf, key, 64, window=window), relabel_buffer.sample(buf, key, 64)
+        )
+    part = relabel_buffer.insert(relabel_buffer.init(8, 1, 1, 1), *_rows([1, 2]), jnp.ones(2, bool))
+    chex.assert_trees_all_equal(relabel_buffer.sample(part, key, 64, window=3), relabel_buffer.sample(part, key, 64))
+    np.testing.assert_array_equal(relabel_buffer.newest(part, 3), relabel_buffer.filled(part))
+
+
 def _held_buffer():
     buf = relabel_buffer.init(100, 1, 1, 1)
     buf = relabel_buffer.insert(buf, *_rows(np.arange(1, 21)), jnp.ones(20, bool))

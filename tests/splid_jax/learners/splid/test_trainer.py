@@ -149,3 +149,23 @@ def test_bc_reuse_sets_the_steps_by_the_pairs_stored_and_is_a_traced_setting(tra
         assert int(m["bc_steps"]) == want, (reuse, stored)
     assert 1 < int(np.ceil(0.5 * stored / 128)) < 50  # the 0.5 case falls inside the bounds
     assert iteration._cache_size() == 1
+
+
+def test_a_buffer_window_clones_the_newest_pairs_alone():
+    env = envs.make("point")
+    trainer = Trainer(env, TrainConfig(**{**CFG, "buffer_size": 64, "bc_steps": 1}))
+    ts = trainer.init(jax.random.PRNGKey(0))
+    obs = jax.random.uniform(jax.random.PRNGKey(1), (40, env.obs_size), minval=-1.0, maxval=1.0)
+    goal = jax.random.uniform(jax.random.PRNGKey(2), (40, env.goal_size), minval=-1.0, maxval=1.0)
+    action = jax.random.uniform(jax.random.PRNGKey(3), (40, env.action_size), minval=-1.0, maxval=1.0)
+    buf = relabel_buffer.insert(ts.buffer, obs, goal, action, jnp.ones(40, bool))
+    clone = jax.jit(trainer.clone)
+
+    def loss(window):
+        hyper = trainer.hyper().replace(buffer_window=jnp.int32(window))
+        return float(clone(ts.policy, ts.opt_state, ts.online, buf, jax.random.PRNGKey(4), hyper)[-1])
+
+    params = ts.policy.params if ts.online is None else ts.online
+    newest = float(bc_loss(params, trainer.policy, ts.policy, obs[39:], goal[39:], action[39:]))
+    np.testing.assert_allclose(loss(1), newest, rtol=1e-5)
+    assert abs(loss(64) - newest) > 1e-3
