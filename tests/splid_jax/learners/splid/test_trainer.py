@@ -100,15 +100,14 @@ def test_subgoals_change_the_evaluation_and_nothing_the_training_does(trainer):
     env = trainer.env
     steering = Trainer(env, TrainConfig(**CFG, eval_subgoal_reach=env.success_distance))
     key = jax.random.PRNGKey(3)
-    plain_state, plain = trainer.jitted(trainer.init(key), trainer.hyper())
-    steered_state, steered = jax.jit(steering.chunk)(steering.init(key), steering.hyper())
-    # explore, SELECT and BC alike: to float rounding (two programs, fused apart), integers and keys exactly
-    for a, b in zip(jax.tree_util.tree_leaves(plain_state), jax.tree_util.tree_leaves(steered_state), strict=True):
-        a, b = np.asarray(a), np.asarray(b)
-        if np.issubdtype(a.dtype, np.floating):
-            np.testing.assert_allclose(a, b, rtol=1e-4, atol=1e-6)
-        else:
-            np.testing.assert_array_equal(a, b)
+    state = trainer.init(key)
+    # explore, SELECT and BC: the same computation, equation for equation (two compiled chunks round apart,
+    # and one SELECT verdict flipped by rounding parts their runs)
+    jaxpr = lambda t: str(jax.make_jaxpr(t.iteration)(state, t.hyper()))  # noqa: E731
+    assert jaxpr(steering) == jaxpr(trainer)
+    assert jax.tree.all(jax.tree.map(lambda a, b: bool(a == b), steering.hyper(), trainer.hyper()))
+    _, plain = trainer.jitted(state, trainer.hyper())
+    _, steered = jax.jit(steering.chunk)(steering.init(key), steering.hyper())
     assert float(plain["eval_return"]) != float(steered["eval_return"])
 
 
