@@ -34,7 +34,7 @@ from splid_jax.config import PROVENANCE, TASK_DEFAULTS, TrainConfig  # noqa: E40
 from splid_jax.learners import registry  # noqa: E402
 from splid_jax.runtime import checkpoint, loop, multihost, progress  # noqa: E402
 from splid_jax.runtime.loop import RunStopped, make_env  # noqa: E402
-from splid_jax.runtime.run_files import MAY_CHANGE_ON_RESUME, env_settings  # noqa: E402
+from splid_jax.runtime.run_files import EXPORT, MAY_CHANGE_ON_RESUME, env_settings  # noqa: E402
 
 __all__ = ["RunStopped", "build_parser", "config_from_cli", "env_settings", "main", "make_env", "run"]
 
@@ -92,6 +92,9 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
         raise InvalidConfig("resume", ns.resume, f"a run directory whose config.json can be read ({why})")
     if not os.path.isfile(path):
         raise InvalidConfig("resume", ns.resume, "a run directory holding config.json")
+    if os.path.isfile(os.path.join(ns.resume, EXPORT)):
+        why = f"a run train wrote, not an export without its buffer (its {EXPORT} names the run)"
+        raise InvalidConfig("resume", ns.resume, why)
     names = {f.name for f in dataclasses.fields(TrainConfig)}
     try:
         with open(path) as fh:

@@ -65,16 +65,38 @@ def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
     return env, trainer, jax.tree.map(lambda x: x[index], state), step
 
 
+def restore_run(run_dir: str, step: int | None = None, cfg=None):
+    """(config, our task, algorithm, trained state, step) of the run in ``run_dir`` at checkpoint ``step``
+    (default: the newest): a run of train, or a member of a sweep, of any task. ``cfg``: the run's config
+    as the caller changed it (default: its config.json)."""
+    from splid_jax.common.networks import PolicyState
+    from splid_jax.rollout import load_config, load_policy
+    from splid_jax.runtime import checkpoint
+
+    if not os.path.isdir(run_dir):
+        raise EvaluationError(f"{run_dir} is not a directory")
+    cfg = load_config(run_dir) if cfg is None else cfg
+    sweep = sweep_member(run_dir) if checkpoint.latest_step(run_dir) is None else None
+    if checkpoint.latest_step(run_dir) is None and (sweep is None or checkpoint.latest_step(sweep[0]) is None):
+        raise EvaluationError(f"{run_dir} holds no checkpoint (train writes them in {run_dir}/checkpoints)")
+    with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
+        if sweep is None:
+            env, trainer, state, step = load_policy(cfg, step)
+        else:
+            env, trainer, state, step = _restore_member(cfg, sweep, step)
+    if not isinstance(getattr(state, "policy", None), PolicyState):
+        raise EvaluationError(f"the checkpoint of {run_dir} holds no policy (no networks.PolicyState at .policy)")
+    return cfg, env, trainer, state, step
+
+
 def load_run(run_dir: str, step: int | None = None, env_options: str = "", subgoal_reach: float | None = None):
     """(config, our task, the policy as the run's evaluations acted (``act(pstate, obs, goal)``, steered at
     subgoals where the run's ``eval_subgoal_reach`` says), its ``PolicyState``, step) of the run in ``run_dir``:
     a run of train, or a member of a sweep. ``env_options`` (``KEY=VALUE,...``) change our task's fields
     from the run's, e.g. ``table=box`` to put the reference's table edges in our task; ``subgoal_reach``
     replaces the run's ``eval_subgoal_reach``."""
-    from splid_jax.common.networks import PolicyState
     from splid_jax.common.subgoals import steered
-    from splid_jax.rollout import load_config, load_policy
-    from splid_jax.runtime import checkpoint
+    from splid_jax.rollout import load_config
 
     if not os.path.isdir(run_dir):
         raise EvaluationError(f"{run_dir} is not a directory")
@@ -84,18 +106,8 @@ def load_run(run_dir: str, step: int | None = None, env_options: str = "", subgo
     if subgoal_reach is not None:
         cfg = dataclasses.replace(cfg, eval_subgoal_reach=subgoal_reach)
     reference_id(cfg.env)
-    sweep = sweep_member(run_dir) if checkpoint.latest_step(run_dir) is None else None
-    if checkpoint.latest_step(run_dir) is None and (sweep is None or checkpoint.latest_step(sweep[0]) is None):
-        raise EvaluationError(f"{run_dir} holds no checkpoint (train writes them in {run_dir}/checkpoints)")
-    with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
-        if sweep is None:
-            env, trainer, state, step = load_policy(cfg, step)
-        else:
-            env, trainer, state, step = _restore_member(cfg, sweep, step)
-    pstate = getattr(state, "policy", None)
-    if not isinstance(pstate, PolicyState):
-        raise EvaluationError(f"the checkpoint of {run_dir} holds no policy (no networks.PolicyState at .policy)")
-    return cfg, env, steered(trainer.policy, env, cfg.eval_subgoal_reach), pstate, step
+    cfg, env, trainer, state, step = restore_run(run_dir, step, cfg)
+    return cfg, env, steered(trainer.policy, env, cfg.eval_subgoal_reach), state.policy, step
 
 
 def policy_act(policy, pstate):

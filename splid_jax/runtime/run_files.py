@@ -19,6 +19,7 @@ from splid_jax.runtime import checkpoint, progress
 MAY_CHANGE_ON_RESUME = frozenset({"iterations", "run_dir", "checkpoint_every", "num_devices"})
 METRICS = "metrics.jsonl"
 SWEEP = "sweep.json"  # a sweep's config and its members' configs, from which it resumes
+EXPORT = "export.json"  # an exported policy's source run and checkpoint (``splid_jax.export``); not resumed
 
 
 def env_settings(env: envs.GoalEnv) -> dict:

@@ -1,0 +1,103 @@
+"""``python -m splid_jax.export RUN_DIR... --out DIR``: each run's policy, at a checkpoint, as a run directory
+of its own without the relabel or replay buffer, small enough to copy off the machine that trained it and
+evaluate elsewhere (``splid_jax.evaluate OUT/NAME --reference``, ``splid_jax.rollout OUT/NAME``).
+
+A run's checkpoint holds its whole state, buffer included (a 5-seed Push sweep: tens of MB; HER: about 0.7 GB);
+the exported one holds the policy and its normaliser, in the state of the same learner with a one-slot buffer.
+Its config.json says so (``buffer_size`` 1, HER's ``buffer_transitions`` one episode), and export.json names
+the run and checkpoint it came from; it evaluates, and is refused for ``--resume``."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import shutil
+import sys
+from collections.abc import Sequence
+
+from splid_jax.cli import Parser, exit_with, quiet_interrupts
+from splid_jax.common.errors import InvalidConfig, check
+from splid_jax.runtime.run_files import EXPORT
+
+
+def _options(settings, **changed) -> str:
+    """A learner's options (``HerConfig``) as ``KEY=VALUE,...`` text: the fields that differ from their
+    defaults, with ``changed`` applied."""
+    values = {f.name: getattr(settings, f.name) for f in dataclasses.fields(settings)}
+    values.update(changed)
+    defaults = {f.name: f.default for f in dataclasses.fields(settings)}
+    show = lambda v: ",".join(map(str, v)) if isinstance(v, tuple) else str(v)  # noqa: E731
+    return ",".join(f"{k}={show(v)}" for k, v in values.items() if v != defaults[k])
+
+
+def without_buffer(cfg, env):
+    """``cfg`` with the smallest buffer its learner builds: the state keeps its layout but not the data."""
+    from splid_jax.learners.her.config import HerConfig
+    from splid_jax.learners.imitation.config import ImitationConfig
+
+    settings = cfg.learner_config()
+    if isinstance(settings, ImitationConfig):
+        return dataclasses.replace(cfg, buffer_size=1, buffer_window=0)
+    if isinstance(settings, HerConfig):
+        return dataclasses.replace(cfg, her_options=_options(settings, buffer_transitions=env.episode_length))
+    return cfg  # ES keeps no buffer
+
+
+def export(run_dir: str, out: str, step: int | None = None) -> dict:
+    """Writes ``out`` (a new directory): config.json, the run's metrics, the policy at checkpoint ``step``
+    (default: the newest) and export.json; returns export.json's record."""
+    import jax
+
+    from splid_jax.learners.registry import make_algorithm
+    from splid_jax.reference.policy import restore_run
+    from splid_jax.runtime import checkpoint
+    from splid_jax.runtime.run_files import env_settings
+
+    check(not os.path.exists(out), "out", out, "a directory that does not exist yet (an export never overwrites)")
+    cfg, env, _, state, step = restore_run(run_dir, step)
+    small = dataclasses.replace(without_buffer(cfg, env), run_dir=out)
+    like = make_algorithm(small, env).init(jax.random.PRNGKey(0))
+    exported = like.replace(policy=state.policy)
+    record = {"run_dir": os.path.abspath(run_dir), "step": int(step), "config": cfg.to_json()}
+    os.makedirs(out)
+    with open(os.path.join(out, "config.json"), "w") as fh:
+        json.dump(small.to_json(), fh, indent=2)
+    metrics = os.path.join(run_dir, "metrics.jsonl")
+    if os.path.isfile(metrics):
+        shutil.copyfile(metrics, os.path.join(out, "metrics.jsonl"))
+    checkpoint.save(out, step, exported, {"env": env_settings(env), "exported_from": record["run_dir"]})
+    with open(os.path.join(out, EXPORT), "w") as fh:
+        json.dump(record, fh, indent=2)
+    return record
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = Parser(prog="python -m splid_jax.export", description=__doc__.split("\n\n")[0])
+    parser.add_argument("run_dirs", nargs="+", metavar="RUN_DIR", help="a run of train, or a member of a sweep")
+    parser.add_argument("--out", required=True, metavar="DIR", help="the directory each run's export is written in")
+    parser.add_argument("--step", type=int, default=None, help="the checkpoint (default: each run's newest)")
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    from splid_jax.reference.extra import EvaluationError
+    from splid_jax.runtime.checkpoint import CheckpointError
+
+    ns = build_parser().parse_args(argv)
+    names = [os.path.basename(os.path.abspath(d)) for d in ns.run_dirs]
+    try:
+        check(len(set(names)) == len(names), "run_dirs", " ".join(ns.run_dirs), "runs of distinct directory names")
+        for run_dir, name in zip(ns.run_dirs, names, strict=True):
+            record = export(run_dir, os.path.join(ns.out, name), ns.step)
+            print(f"{run_dir} (iteration {record['step']}) -> {os.path.join(ns.out, name)}")
+    except (InvalidConfig, EvaluationError, CheckpointError) as e:
+        print(f"python -m splid_jax.export: error: {e}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    quiet_interrupts()
+    exit_with(main())

@@ -1,0 +1,67 @@
+"""Exporting a run's policy without its buffer: the same policy loads from the export, which is small
+and cannot be resumed."""
+
+import json
+
+import jax
+import numpy as np
+
+from splid_jax import export, train
+from splid_jax.config import TrainConfig
+from splid_jax.learners.registry import make_algorithm
+from splid_jax.reference.policy import restore_run
+from splid_jax.runtime import checkpoint
+from splid_jax.runtime.loop import make_env
+from splid_jax.runtime.run_files import env_settings
+
+
+def _saved_run(run_dir, **fields):
+    """A run directory of train's layout whose checkpoint at step 3 holds a freshly built state."""
+    cfg = TrainConfig(env="reach", iterations=3, eval_every=1, num_envs=2, run_dir=str(run_dir), **fields)
+    env = make_env(cfg.env)
+    state = make_algorithm(cfg, env).init(jax.random.PRNGKey(7))
+    checkpoint.save(run_dir, 3, state, {"env": env_settings(env)})
+    (run_dir / "config.json").write_text(json.dumps(cfg.to_json()))
+    (run_dir / "metrics.jsonl").write_text(json.dumps({"iteration": 3, "eval_success": 0.5}) + "\n")
+    return state
+
+
+def _same_policy(a, b):
+    for x, y in zip(jax.tree.leaves(a), jax.tree.leaves(b), strict=True):
+        np.testing.assert_array_equal(np.asarray(x), np.asarray(y))
+
+
+def test_an_export_holds_the_runs_policy_and_a_one_slot_buffer(tmp_path, capsys):
+    run = tmp_path / "run"
+    state = _saved_run(run, hidden=(8,), buffer_size=4096, batch_size=4)
+    assert export.main([str(run), "--out", str(tmp_path / "out")]) == 0
+    assert "(iteration 3)" in capsys.readouterr().out
+    cfg, _, _, loaded, step = restore_run(str(tmp_path / "out" / "run"))
+    assert step == 3 and cfg.buffer_size == 1 and loaded.buffer.obs.shape[0] == 1
+    _same_policy(loaded.policy, state.policy)
+    record = json.loads((tmp_path / "out" / "run" / "export.json").read_text())
+    assert record["run_dir"] == str(run) and record["step"] == 3 and record["config"]["buffer_size"] == 4096
+    assert (tmp_path / "out" / "run" / "metrics.jsonl").read_text() == (run / "metrics.jsonl").read_text()
+
+
+def test_her_exports_with_one_episode_of_replay_and_its_other_options_kept(tmp_path):
+    run = tmp_path / "her"
+    state = _saved_run(run, algo="her", her_options="hidden=8,8,buffer_transitions=500,n_batches=2")
+    assert export.main([str(run), "--out", str(tmp_path / "out")]) == 0
+    cfg, env, algo, loaded, _ = restore_run(str(tmp_path / "out" / "her"))
+    her = cfg.learner_config()
+    assert (her.buffer_transitions, her.hidden, her.n_batches) == (env.episode_length, (8, 8), 2)
+    _same_policy(loaded.policy, state.policy)
+
+
+def test_an_export_is_refused_over_an_existing_directory_and_for_resume(tmp_path, capsys):
+    run = tmp_path / "run"
+    _saved_run(run, hidden=(8,), buffer_size=64, batch_size=4)
+    (tmp_path / "out" / "run").mkdir(parents=True)
+    assert export.main([str(run), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "invalid out=" in err and "does not exist yet" in err
+    assert export.main([str(run), "--out", str(tmp_path / "new")]) == 0
+    assert train.main(["--resume", str(tmp_path / "new" / "run"), "--iterations", "6"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.splitlines()[-1].endswith("(its export.json names the run)")
