@@ -17,11 +17,15 @@ from matplotlib.figure import Figure
 METHODS = {"splid": "SPLID", "no-select": "SPLID without SELECT", "gcsl": "GCSL"}
 
 
-def member_rows(figure_dir: str, method: str) -> list[list[dict]]:
-    record = json.load(open(os.path.join(figure_dir, "figure.json")))
-    members = record["runs"][method]["members"]
-    paths = [os.path.join(figure_dir, method, m["run_dir"], "metrics.jsonl") for m in members]
-    return [[json.loads(line) for line in open(p)] for p in paths]
+def member_rows(figure_dir: str, method: str) -> tuple[dict, list[list[dict]]]:
+    """The method's first member's config and every member's metrics."""
+    with open(os.path.join(figure_dir, "figure.json")) as fh:
+        members = json.load(fh)["runs"][method]["members"]
+    rows = []
+    for member in members:
+        with open(os.path.join(figure_dir, method, member["run_dir"], "metrics.jsonl")) as fh:
+            rows.append([json.loads(line) for line in fh])
+    return members[0], rows
 
 
 def mean_over_seeds(rows: list[list[dict]], key: str) -> tuple[np.ndarray, np.ndarray]:
@@ -45,8 +49,7 @@ def main() -> None:
     fig = Figure(figsize=(14, 4.2))
     axes = fig.subplots(1, 3)
     for method, label in METHODS.items():
-        rows = member_rows(ns.figure_dir, method)
-        config = json.load(open(os.path.join(ns.figure_dir, method, "s0", "config.json")))
+        config, rows = member_rows(ns.figure_dir, method)
         line = None
         for key, style in (("eval_success", "-"), ("eval_success_final", ":")):
             episodes, value = mean_over_seeds(rows, key)

@@ -76,8 +76,9 @@ def restore_run(run_dir: str, step: int | None = None, cfg=None):
     if not os.path.isdir(run_dir):
         raise EvaluationError(f"{run_dir} is not a directory")
     cfg = load_config(run_dir) if cfg is None else cfg
-    sweep = sweep_member(run_dir) if checkpoint.latest_step(run_dir) is None else None
-    if checkpoint.latest_step(run_dir) is None and (sweep is None or checkpoint.latest_step(sweep[0]) is None):
+    own = checkpoint.latest_step(run_dir) is not None
+    sweep = None if own else sweep_member(run_dir)
+    if not own and (sweep is None or checkpoint.latest_step(sweep[0]) is None):
         raise EvaluationError(f"{run_dir} holds no checkpoint (train writes them in {run_dir}/checkpoints)")
     with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
         if sweep is None:
