@@ -196,11 +196,16 @@ def _check_layout(saved: dict[str, Any], like: dict[str, Any]) -> str | None:
 
 
 def _restore_target(like_state: Any) -> Any:
-    """Concrete arrays become shape/dtype/sharding stubs; numpy scalars, which orbax cannot target, 0-d arrays."""
+    """Concrete arrays become shape/dtype/sharding stubs; numpy scalars, which orbax cannot target, 0-d arrays.
+    An abstract leaf without a sharding is placed on this process's first device: orbax would otherwise take the
+    saved one, which names a device of the machine that trained (a GPU's checkpoint evaluated on a CPU)."""
+    local = jax.sharding.SingleDeviceSharding(jax.local_devices()[0])
 
     def target(x: Any) -> Any:
         if isinstance(x, jax.Array):
             return ocp.utils.to_shape_dtype_struct(x)
+        if isinstance(x, jax.ShapeDtypeStruct) and x.sharding is None:
+            return jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=local)
         return np.asarray(x) if isinstance(x, np.generic) else x
 
     return jax.tree.map(target, like_state)

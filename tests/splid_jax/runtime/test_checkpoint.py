@@ -84,6 +84,21 @@ def test_round_trip_is_bitwise(tmp_path):
     assert_bitwise_equal(abstract_restored.replace(episodes=0), state.replace(episodes=0))
 
 
+def test_a_checkpoint_saved_on_another_machines_device_restores_here(tmp_path):
+    """A GPU run's checkpoint names its device (cuda:0) in the saved shardings; an abstract template, as the
+    evaluation and export tools build, restores it onto this machine's device."""
+    state = make_state(2)
+    assert ck.save(tmp_path, 10, state, META)
+    (sharding,) = ck.checkpoint_dir(tmp_path).glob("10/*/_sharding")
+    text = sharding.read_text()
+    here = jax.local_devices()[0]
+    assert text.count(f'\\"{here}\\"') > 0
+    sharding.write_text(text.replace(f'\\"{here}\\"', '\\"cuda:0\\"'))
+    _, restored, _ = ck.restore(tmp_path, jax.eval_shape(lambda: make_state(0)))
+    assert_bitwise_equal(restored.replace(episodes=0), state.replace(episodes=0))
+    assert all(x.devices() == {here} for x in jax.tree.leaves(restored))
+
+
 def test_latest_step_and_max_to_keep(tmp_path):
     assert ck.latest_step(tmp_path) is None
     for step in range(1, 6):
