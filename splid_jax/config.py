@@ -155,6 +155,14 @@ class TrainConfig:
         recorded_when_set=True,
         unrecorded=0,
     )
+    buffer_window_grow: int = field(
+        0,
+        "cloning learners, with buffer_window: the window grows linearly from buffer_window to the whole buffer "
+        "over the first buffer_window_grow iterations, so the start clones the newest pairs and a long run keeps "
+        "the learning phase's; a traced setting (0: fixed)",
+        recorded_when_set=True,
+        unrecorded=0,
+    )
     batch_size: int = field(None, "behaviour-cloning minibatch size")
     bc_steps: int = field(None, "behaviour-cloning gradient steps per iteration (with bc_reuse: at most)")
     bc_reuse: float = field(

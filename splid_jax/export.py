@@ -39,7 +39,7 @@ def without_buffer(cfg, env):
 
     settings = cfg.learner_config()
     if isinstance(settings, ImitationConfig):
-        return dataclasses.replace(cfg, buffer_size=1, buffer_window=0)
+        return dataclasses.replace(cfg, buffer_size=1, buffer_window=0, buffer_window_grow=0)
     if isinstance(settings, HerConfig):
         return dataclasses.replace(cfg, her_options=_options(settings, buffer_transitions=env.episode_length))
     return cfg  # ES keeps no buffer

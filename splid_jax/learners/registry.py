@@ -58,6 +58,7 @@ _IMITATION = dict(
         "held_share",
         "bc_reuse",
         "buffer_window",
+        "buffer_window_grow",
     ),
 )
 # HER on the Fetch tasks runs as OpenAI Baselines: a cycle explores 2 episodes on each of 8 workers

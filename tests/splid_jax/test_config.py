@@ -84,12 +84,20 @@ def test_held_share_outside_its_range_or_without_held_goals_names_the_field(fiel
 
 
 @pytest.mark.parametrize(
-    "fields", [{"buffer_window": -1}, {"buffer_window": 20_001, "buffer_size": 20_000}, {"bc_reuse": -1.0}]
+    "fields",
+    [
+        {"buffer_window": -1},
+        {"buffer_window": 20_001, "buffer_size": 20_000},
+        {"bc_reuse": -1.0},
+        {"buffer_window_grow": -1, "buffer_window": 5_000},
+        {"buffer_window_grow": 100},  # without a window: the whole buffer already
+    ],
 )
 def test_a_buffer_window_beyond_the_buffer_or_a_negative_reuse_names_the_field(fields):
     with pytest.raises(InvalidConfig, match=f"invalid {next(iter(fields))}="):
         TrainConfig(env="point", **fields)
     assert TrainConfig(env="point", buffer_size=20_000, buffer_window=5_000, bc_reuse=30.0).buffer_window == 5_000
+    assert TrainConfig(env="point", buffer_size=20_000, buffer_window=5_000, buffer_window_grow=40).buffer_window_grow
 
 
 def test_rest_horizon_within_the_episode_is_accepted():

@@ -40,6 +40,7 @@ class ImitationConfig:
     held_share: float
     buffer_size: int
     buffer_window: int
+    buffer_window_grow: int
     batch_size: int
     bc_steps: int
     bc_reuse: float
@@ -97,6 +98,10 @@ class ImitationConfig:
         window = self.buffer_window
         allowed = f"in [0, {self.buffer_size}] (buffer_size; 0: the whole buffer)"
         check(0 <= window <= self.buffer_size, "buffer_window", window, allowed)
+        grow = self.buffer_window_grow
+        check(grow >= 0, "buffer_window_grow", grow, "an integer >= 0 (0: a fixed window)")
+        allowed = "0 without buffer_window (the window is already the whole buffer)"
+        check(grow == 0 or window > 0, "buffer_window_grow", grow, allowed)
         check(self.batch_size >= 1, "batch_size", self.batch_size, "an integer >= 1")
         check(self.bc_steps >= 1, "bc_steps", self.bc_steps, "an integer >= 1 (no step leaves the loss undefined)")
         check(self.bc_reuse >= 0, "bc_reuse", self.bc_reuse, ">= 0 (0: bc_steps every iteration)")

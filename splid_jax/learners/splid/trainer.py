@@ -52,6 +52,7 @@ class Hyper:
     held_share: jax.Array  # [] float32, the share of BC's batches drawn from the held-goal pairs
     bc_reuse: jax.Array  # [] float32, BC samples per new pair (0: the configured steps every iteration)
     buffer_window: jax.Array  # [] int32, BC draws from the newest this many pairs (the capacity: all)
+    buffer_window_grow: jax.Array  # [] int32, iterations over which the window grows to the capacity (0: fixed)
 
 
 class Trainer(Chunked):
@@ -104,6 +105,7 @@ class Trainer(Chunked):
             held_share=jnp.float32(bc.held_share),
             bc_reuse=jnp.float32(bc.bc_reuse),
             buffer_window=jnp.int32(bc.buffer_window or self.bc.buffer_size),
+            buffer_window_grow=jnp.int32(bc.buffer_window_grow),
         )
 
     def init(self, key: jax.Array) -> TrainState:
@@ -145,7 +147,8 @@ class Trainer(Chunked):
         pstate = policy.update_normaliser(ts.policy, seen.obs, seen.achieved[:-1], ~seen.invalid[:-1])
         stored = jnp.sum(cands.accept, dtype=jnp.int32)
         steps = self.bc_steps_for(stored, hyper)
-        pstate, opt_state, online, loss = self.clone(pstate, ts.opt_state, ts.online, buf, k_bc, hyper, steps)
+        now = hyper.replace(buffer_window=self.window_at(ts.iteration, hyper))
+        pstate, opt_state, online, loss = self.clone(pstate, ts.opt_state, ts.online, buf, k_bc, now, steps)
         metrics = {
             "select_pairs": jnp.sum(cands.valid, dtype=jnp.int32),
             "select_held": jnp.sum(cands.valid & cands.held, dtype=jnp.int32),
@@ -196,6 +199,14 @@ class Trainer(Chunked):
         bc = self.bc
         wanted = jnp.ceil(hyper.bc_reuse * stored.astype(jnp.float32) / bc.batch_size).astype(jnp.int32)
         return jnp.where(hyper.bc_reuse > 0, jnp.clip(wanted, 1, bc.bc_steps), bc.bc_steps)
+
+    def window_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:
+        """BC's window this iteration: buffer_window, growing linearly to the buffer's capacity over the first
+        buffer_window_grow iterations."""
+        grow = hyper.buffer_window_grow
+        fraction = jnp.minimum(1.0, iteration.astype(jnp.float32) / jnp.maximum(grow, 1).astype(jnp.float32))
+        grown = hyper.buffer_window + jnp.round((self.bc.buffer_size - hyper.buffer_window) * fraction)
+        return jnp.where(grow > 0, grown.astype(jnp.int32), hyper.buffer_window)
 
     def clone(self, pstate, opt_state, online, buf: relabel_buffer.Buffer, key, hyper: Hyper, steps=None):
         """Behaviour cloning on the buffer, at ``hyper``'s rate and acting average, ``steps`` of the

@@ -37,8 +37,10 @@ def test_every_name_builds_its_own_learner_from_its_own_settings():
             changed = {field: value + 1 if isinstance(value, int) else value / 2 + 0.1}
             if field == "held_share":  # a share of the held goals that only the holding relabellings add
                 changed["relabel"] = "hold"
-            other = dataclasses.replace(cfg, **changed)
-            assert not all(jax.tree.leaves(jax.tree.map(lambda a, b: a == b, algo.hyper(other), hyper))), field
+            base = dataclasses.replace(cfg, buffer_window=1) if field == "buffer_window_grow" else cfg  # grows from it
+            other = dataclasses.replace(base, **changed)
+            same = jax.tree.map(lambda a, b: a == b, algo.hyper(other), algo.hyper(base))
+            assert not all(jax.tree.leaves(same)), field
 
 
 def test_a_learner_reads_its_settings_and_the_runs_and_ignores_the_others():
@@ -58,7 +60,7 @@ def test_only_the_cloning_learners_split_a_run_and_sweep_their_settings():
     splits = {name for name, x in registry.LEARNERS.items() if x.splits_envs}
     assert splits == {"splid", "gcsl", "pchid"}
     traced = ("sigma", "horizon", "horizon_end", "sigma_end", "learning_rate", "policy_ema", "gripper_hold")
-    traced += ("explore_subgoal_reach", "held_share", "bc_reuse", "buffer_window")
+    traced += ("explore_subgoal_reach", "held_share", "bc_reuse", "buffer_window", "buffer_window_grow")
     assert all(registry.get(n).sweeps == (traced if n in splits else ()) for n in registry.names())
     assert [n for n, x in registry.LEARNERS.items() if x.grows_horizon] == ["pchid"]
     assert [n for n, x in registry.LEARNERS.items() if x.clones_every_pair] == ["gcsl"]

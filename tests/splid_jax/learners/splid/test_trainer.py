@@ -150,6 +150,32 @@ def test_bc_reuse_sets_the_steps_by_the_pairs_stored_and_is_a_traced_setting(tra
     assert iteration._cache_size() == 1
 
 
+def test_a_growing_window_widens_linearly_to_the_whole_buffer_and_a_fixed_one_stays():
+    trainer = Trainer(envs.make("point"), TrainConfig(**{**CFG, "buffer_size": 1_000, "buffer_window": 200}))
+    window_at = jax.jit(trainer.window_at)
+    at = lambda i, grow: int(window_at(jnp.int32(i), trainer.hyper().replace(buffer_window_grow=jnp.int32(grow))))  # noqa: E731
+    assert [at(i, 40) for i in (0, 10, 20, 40, 41, 500)] == [200, 400, 600, 1_000, 1_000, 1_000]
+    assert [at(i, 0) for i in (0, 20, 500)] == [200, 200, 200]
+    whole = Trainer(envs.make("point"), TrainConfig(**{**CFG, "buffer_size": 1_000}))
+    assert int(whole.window_at(jnp.int32(7), whole.hyper())) == 1_000
+
+
+def test_the_iteration_clones_from_the_grown_window():
+    """A window of one pair growing over one iteration: the first iteration clones as the fixed window does, the
+    second from the whole buffer."""
+    trainer = Trainer(envs.make("point"), TrainConfig(**{**CFG, "buffer_size": 1_000, "buffer_window": 1}))
+    step = jax.jit(trainer.iteration)
+    runs = []
+    for grow in (0, 1):
+        ts, hyper = trainer.init(jax.random.PRNGKey(0)), trainer.hyper().replace(buffer_window_grow=jnp.int32(grow))
+        first, _ = step(ts, hyper)
+        second, _ = step(first, hyper)
+        runs.append((first.policy.params, second.policy.params))
+    leaves = lambda tree: [np.asarray(x) for x in jax.tree.leaves(tree)]  # noqa: E731
+    assert all(np.array_equal(a, b) for a, b in zip(leaves(runs[0][0]), leaves(runs[1][0]), strict=True))
+    assert not all(np.array_equal(a, b) for a, b in zip(leaves(runs[0][1]), leaves(runs[1][1]), strict=True))
+
+
 def test_a_buffer_window_clones_the_newest_pairs_alone():
     env = envs.make("point")
     trainer = Trainer(env, TrainConfig(**{**CFG, "buffer_size": 64, "bc_steps": 1}))
