@@ -24,6 +24,7 @@ from splid_jax.cli import Parser
 from splid_jax.common import stats
 from splid_jax.common.paths import unreadable
 from splid_jax.common.stats import smooth
+from splid_jax.config import PROVENANCE, TrainConfig
 from splid_jax.learners import registry
 from splid_jax.runtime import progress
 
@@ -42,7 +43,9 @@ REQUIRED = (
     "wall_s",
 )
 # Config keys that never change what a run learns, so they neither label nor split runs.
-_NOT_IDENTITY = {"run_dir", "seed", "checkpoint_every"}
+_NOT_IDENTITY = {"run_dir", "seed", "checkpoint_every", *PROVENANCE}
+# a setting added after some runs were recorded reads, for those runs, as they behaved
+_UNRECORDED = {f.name: f.metadata["unrecorded"] for f in dataclasses.fields(TrainConfig) if "unrecorded" in f.metadata}
 _STEP_AXES = {
     "env": ("env_steps", "exploration env steps"),
     "all": ("sim_steps", "simulator steps (env + SELECT replay)"),
@@ -118,7 +121,8 @@ def labels(runs: Sequence[Run]) -> tuple[list[str], list[str]]:
     """
     configs = [r.config for r in runs if "env" in r.config]
     keys = sorted({k for c in configs for k in c} - _NOT_IDENTITY - {"env", "select"})
-    varying = [k for k in keys if len({json.dumps(c.get(k), sort_keys=True) for c in configs}) > 1]
+    value = lambda c, k: c.get(k, _UNRECORDED.get(k))  # noqa: E731
+    varying = [k for k in keys if len({json.dumps(value(c, k), sort_keys=True) for c in configs}) > 1]
     full, group = [], []
     for run in runs:
         c = run.config
@@ -131,7 +135,7 @@ def labels(runs: Sequence[Run]) -> tuple[list[str], list[str]]:
         selects = algo not in registry.LEARNERS or registry.reads(algo, "select")  # HER, ES and GCSL do not
         if "select" in c and selects:
             parts.append(_fmt("select", c["select"]))
-        parts += [_fmt(k, c.get(k)) for k in varying]
+        parts += [_fmt(k, value(c, k)) for k in varying]
         group.append(" ".join(parts))
         full.append(" ".join(parts + ([f"s{c['seed']}"] if "seed" in c else [])))
     seen: dict[str, int] = {}

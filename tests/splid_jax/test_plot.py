@@ -91,6 +91,20 @@ def test_a_learner_without_select_is_not_labelled_select(tmp_path):
     assert plot.labels(runs)[0] == ["point algo=her s0", "point select algo=splid s0"]
 
 
+def test_labels_leave_out_the_device_and_read_a_later_setting_as_runs_before_it_behaved(tmp_path):
+    gpu = lambda kind: {"devices": {"kind": kind, "count": 1}}  # noqa: E731
+    runs = [
+        plot.load_run(make_run(tmp_path, "before", 0, **gpu("H200"))),  # recorded before buffer_window existed
+        plot.load_run(make_run(tmp_path, "whole", 1, buffer_window=0, **gpu("H100"))),
+        plot.load_run(make_run(tmp_path, "window", 2, buffer_window=50, **gpu("H100"))),
+    ]
+    assert plot.labels(runs)[0] == [
+        "point select buffer_window=0 s0",
+        "point select buffer_window=0 s1",
+        "point select buffer_window=50 s2",
+    ]
+
+
 def test_an_unreadable_metrics_file_is_not_called_missing(tmp_path, monkeypatch, capsys):
     run = make_run(tmp_path, "a", 0)
     real_access = os.access  # permissions that bar even root, as a read-only share does for others
