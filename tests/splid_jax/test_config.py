@@ -200,3 +200,25 @@ def test_splid_explores_steered_on_push_slide_and_pick_and_place_and_the_baselin
     from splid_jax.learners import registry
 
     assert [registry.reads(a, "explore_subgoal_reach") for a in registry.names()] == [True, True, True, False, False]
+
+
+def test_splid_on_push_clones_a_window_widening_to_200k_pairs_and_the_baselines_the_newest_50k():
+    from splid_jax.runtime.run_files import identity
+
+    buffer = lambda **kw: (lambda c: (c.buffer_size, c.buffer_window, c.buffer_window_grow))(  # noqa: E731
+        TrainConfig(env="push", **kw)
+    )
+    assert buffer() == buffer(select=False) == (200_000, 50_000, 200)
+    assert buffer(algo="gcsl") == buffer(algo="pchid") == (50_000, 0, 0)
+    assert buffer(algo="her")[1:] == buffer(algo="es")[1:] == (0, 0)  # they read no window
+    assert buffer(buffer_size=200_000) == (200_000, 0, 0)  # a given buffer is cloned whole unless told otherwise
+    assert buffer(buffer_size=20_000) == (20_000, 0, 0)  # and never refused for a window the caller did not set
+    assert buffer(buffer_window=30_000) == (200_000, 30_000, 0)
+    assert buffer(buffer_window_grow=100) == (200_000, 50_000, 100)
+    assert (lambda c: (c.buffer_window, c.buffer_window_grow))(TrainConfig(env="slide")) == (0, 0)
+    # a Push run recorded before the window (the newest 50k pairs, no window fields) resumes as it ran
+    before = {k: v for k, v in TrainConfig(env="push").to_json().items() if not k.startswith("buffer_window")}
+    resumed = TrainConfig.from_json({**before, "buffer_size": 50_000})
+    assert (resumed.buffer_size, resumed.buffer_window, resumed.buffer_window_grow) == (50_000, 0, 0)
+    assert not {"buffer_window", "buffer_window_grow"} & set(identity(resumed))
+    assert identity(TrainConfig(env="push"))["buffer_window_grow"] == 200
