@@ -116,7 +116,9 @@ def grid_configs(
     ``horizon_end`` is given too, as with ``train --horizon``."""
     task_h = None if horizons else TrainConfig(**given).horizon
     grid = members(seeds, sigmas, horizons or (task_h,), base_seed=given.get("seed", 0), varied=varied)
-    fixed = {**given, "sigma": max(sigmas)}
+    # a varied setting counts as given, so the defaults that go with it resolve as with --FIELD (a given window
+    # fixes Push's widening at 0 unless that is given too)
+    fixed = {**given, **{k: max(v) for k, v in (varied or {}).items()}, "sigma": max(sigmas)}
     if horizons:  # shapes for the largest H, as a sweep's
         fixed["horizon"] = max(horizons)
     return member_configs(TrainConfig(**fixed), grid)

@@ -67,6 +67,17 @@ def test_members_take_the_tasks_falling_horizon_unless_horizons_are_given(tmp_pa
     assert [(m.horizon, m.horizon_end) for m in lanes] == [(12, 0), (12, 6)]
 
 
+def test_a_varied_window_resolves_pushs_widening_as_a_given_one_would(tmp_path):
+    given = {"env": "push", "run_dir": str(tmp_path)}
+    window = lambda lanes: [(m.buffer_size, m.buffer_window, m.buffer_window_grow) for m in lanes]  # noqa: E731
+    _, lanes = sweep.grid_configs(given, 1, (1.0,), None, {"buffer_window": (0, 50_000)})
+    assert window(lanes) == [(200_000, 0, 0), (200_000, 50_000, 0)]  # as --buffer-window W: a fixed window
+    _, lanes = sweep.grid_configs(given, 1, (1.0,), None, {"buffer_window_grow": (100, 400)})
+    assert window(lanes) == [(200_000, 50_000, 100), (200_000, 50_000, 400)]
+    _, lanes = sweep.grid_configs(given, 1, (1.0,), None)
+    assert window(lanes) == [(200_000, 50_000, 200)]
+
+
 @pytest.mark.parametrize(
     "vary, field",
     [
