@@ -151,8 +151,7 @@ class TrainConfig:
         None,
         "cloning learners: behaviour cloning draws from the newest buffer_window pairs alone, as a FIFO buffer of "
         "that capacity would hold them; a traced setting, so one sweep compares buffer capacities up to "
-        "buffer_size (0: the whole buffer; Push: 50,000, widening, see buffer_window_grow; with buffer_size given "
-        "and this not, 0)",
+        "buffer_size (0: the whole buffer; with buffer_size given and this not, 0)",
         recorded_when_set=True,
         unrecorded=0,
     )
@@ -160,8 +159,7 @@ class TrainConfig:
         None,
         "cloning learners, with buffer_window: the window grows linearly from buffer_window to the whole buffer "
         "over the first buffer_window_grow iterations, so the start clones the newest pairs and a long run keeps "
-        "the learning phase's; a traced setting (0: fixed; Push: 200; with buffer_size or buffer_window given and "
-        "this not, 0)",
+        "the learning phase's; a traced setting (0: fixed; with buffer_size or buffer_window given and this not, 0)",
         recorded_when_set=True,
         unrecorded=0,
     )
