@@ -315,12 +315,17 @@ class TrainConfig:
         return dataclasses.asdict(self)
 
     @classmethod
+    def unrecorded_values(cls) -> dict[str, Any]:
+        """What each setting added after runs were recorded reads as for those runs: how they behaved."""
+        return {f.name: f.metadata["unrecorded"] for f in dataclasses.fields(cls) if "unrecorded" in f.metadata}
+
+    @classmethod
     def from_json(cls, saved: dict[str, Any], **changes) -> TrainConfig:
         """A config from a run's config.json, which also records the hardware it ran on. Its task options
         are whole, and kept as written (the checkpoint's record holds the same text): a run recorded before a
         task gained a default option resumes as it ran; a setting added since reads as those runs behaved
         (its ``unrecorded`` value)."""
-        unrecorded = {f.name: f.metadata["unrecorded"] for f in dataclasses.fields(cls) if "unrecorded" in f.metadata}
+        unrecorded = cls.unrecorded_values()
         cfg = cls(**{**unrecorded, **{k: v for k, v in saved.items() if k not in PROVENANCE}, **changes})
         options = changes.get("env_options", saved.get("env_options"))
         if isinstance(options, str):  # checked by the construction above

@@ -44,8 +44,7 @@ REQUIRED = (
 )
 # Config keys that never change what a run learns, so they neither label nor split runs.
 _NOT_IDENTITY = {"run_dir", "seed", "checkpoint_every", *PROVENANCE}
-# a setting added after some runs were recorded reads, for those runs, as they behaved
-_UNRECORDED = {f.name: f.metadata["unrecorded"] for f in dataclasses.fields(TrainConfig) if "unrecorded" in f.metadata}
+_UNRECORDED = TrainConfig.unrecorded_values()  # a later setting, for the runs recorded before it
 _STEP_AXES = {
     "env": ("env_steps", "exploration env steps"),
     "all": ("sim_steps", "simulator steps (env + SELECT replay)"),
