@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import os
 import shutil
 import sys
@@ -19,7 +18,7 @@ from collections.abc import Sequence
 
 from splid_jax.cli import Parser, exit_with, quiet_interrupts
 from splid_jax.common.errors import InvalidConfig, check
-from splid_jax.runtime.run_files import EXPORT
+from splid_jax.runtime.run_files import EXPORT, METRICS, env_settings, write_json
 
 
 def _options(settings, **changed) -> str:
@@ -53,7 +52,6 @@ def export(run_dir: str, out: str, step: int | None = None) -> dict:
     from splid_jax.learners.registry import make_algorithm
     from splid_jax.reference.policy import restore_run
     from splid_jax.runtime import checkpoint
-    from splid_jax.runtime.run_files import env_settings
 
     check(not os.path.exists(out), "out", out, "a directory that does not exist yet (an export never overwrites)")
     cfg, env, _, state, step = restore_run(run_dir, step)
@@ -62,14 +60,12 @@ def export(run_dir: str, out: str, step: int | None = None) -> dict:
     exported = like.replace(policy=state.policy)
     record = {"run_dir": os.path.abspath(run_dir), "step": int(step), "config": cfg.to_json()}
     os.makedirs(out)
-    with open(os.path.join(out, "config.json"), "w") as fh:
-        json.dump(small.to_json(), fh, indent=2)
-    metrics = os.path.join(run_dir, "metrics.jsonl")
+    write_json(os.path.join(out, "config.json"), small.to_json())
+    metrics = os.path.join(run_dir, METRICS)
     if os.path.isfile(metrics):
-        shutil.copyfile(metrics, os.path.join(out, "metrics.jsonl"))
+        shutil.copyfile(metrics, os.path.join(out, METRICS))
     checkpoint.save(out, step, exported, {"env": env_settings(env), "exported_from": record["run_dir"]})
-    with open(os.path.join(out, EXPORT), "w") as fh:
-        json.dump(record, fh, indent=2)
+    write_json(os.path.join(out, EXPORT), record)
     return record
 
 
