@@ -68,8 +68,8 @@ _IMITATION = dict(
 _HER_FETCH = dict(num_envs=16, eval_every=50)
 # Steered exploration and Push's widening window were chosen for SPLID; the imitation baselines explore towards the
 # goal, as their papers do, and clone Push's newest 50,000 pairs, the buffer they were measured with
-_UNSTEERED = {task: {"explore_subgoal_reach": 0.0} for task in ("push", "slide", "pick_and_place")}
-_UNSTEERED["push"].update(buffer_size=50_000, buffer_window=0, buffer_window_grow=0)
+_BASELINE_DEFAULTS = {task: {"explore_subgoal_reach": 0.0} for task in ("push", "slide", "pick_and_place")}
+_BASELINE_DEFAULTS["push"].update(buffer_size=50_000, buffer_window=0, buffer_window_grow=0)
 
 LEARNERS: dict[str, Learner] = {
     learner.name: learner
@@ -82,7 +82,7 @@ LEARNERS: dict[str, Learner] = {
             reads=(*_CLONING, "gcsl_relabel"),
             **_IMITATION,
             clones_every_pair=True,
-            task_defaults=_UNSTEERED,
+            task_defaults=_BASELINE_DEFAULTS,
         ),
         Learner(
             "pchid",
@@ -92,7 +92,7 @@ LEARNERS: dict[str, Learner] = {
             **_IMITATION,
             grows_horizon=True,
             # SPLID's falling horizon on Push is not PCHID's
-            task_defaults={**_UNSTEERED, "push": {**_UNSTEERED["push"], "horizon": 8}},
+            task_defaults={**_BASELINE_DEFAULTS, "push": {**_BASELINE_DEFAULTS["push"], "horizon": 8}},
         ),
         Learner(
             "her",
