@@ -99,6 +99,6 @@ _HOMES = {
         "step_response",
     ),
     "splid_jax.reference.policy": ("evaluate", "load_run", "policy_act", "sweep_member"),
-    "splid_jax.reference.cli": ("build_parser", "main", "scripted", "write_json_atomic"),
+    "splid_jax.reference.cli": ("build_parser", "main", "scripted", "write_result"),
 }
 __getattr__, __dir__, __all__ = lazy_names(__name__, _HOMES)

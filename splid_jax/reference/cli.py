@@ -9,7 +9,6 @@ import io
 import json
 import os
 import sys
-import tempfile
 
 import numpy as np
 
@@ -19,14 +18,18 @@ from splid_jax.reference.extra import EXTRA, REFERENCE_IDS, EvaluationError, imp
 from splid_jax.reference.policy import evaluate, load_run, policy_act
 from splid_jax.reference.response import RESPONSE_KEYS, step_response
 from splid_jax.reference.tracing import compare_slots, split_by_final, traces
+from splid_jax.runtime.run_files import write_atomic
 
 
-def write_json_atomic(path: str, obj) -> None:
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".reference-", suffix=".json")
-    with os.fdopen(fd, "w") as fh:
-        json.dump(obj, fh, indent=1)
-    os.replace(tmp, path)
+def _folder(path: str) -> str:
+    return os.path.dirname(os.path.abspath(path))
+
+
+def write_result(path: str, obj) -> None:
+    """The evaluation's JSON, replaced whole. Its folder was checked before the evaluation; made again if it was
+    moved away while the episodes ran, so minutes of evaluation are not lost to a traceback."""
+    os.makedirs(_folder(path), exist_ok=True)
+    write_atomic(path, json.dumps(obj, indent=1))
 
 
 def _line(name: str, s: dict) -> str:
@@ -102,8 +105,9 @@ def main(argv: list[str] | None = None) -> int:
         if a.run_dir is not None and not os.path.isdir(a.run_dir):
             raise EvaluationError(f"{a.run_dir} is not a directory")
         out = a.out or (os.path.join(a.run_dir, "reference.json") if a.run_dir else f"scripted-{a.scripted}.json")
-        if not os.path.isdir(os.path.dirname(os.path.abspath(out))):
-            raise EvaluationError(f"--out {out}: its directory does not exist")
+        for flag, path in (("--out", out), ("--traces", a.traces)):
+            if path is not None and not os.path.isdir(_folder(path)):
+                raise EvaluationError(f"{flag} {path}: its directory does not exist")
         if a.scripted:
             result, tr = scripted(a.scripted, a.episodes, a.seed)
             title = f"the scripted {a.scripted} controller, the same {a.episodes} starts in each"
@@ -127,11 +131,12 @@ def main(argv: list[str] | None = None) -> int:
         from splid_jax.runtime.loop import make_env
 
         resp = step_response(make_env(result["task"]), result["task"])
+        os.makedirs(_folder(a.traces), exist_ok=True)
         np.savez_compressed(a.traces, **tr, **{f"response_{k}": np.asarray(resp[k]) for k in RESPONSE_KEYS})
         result["traces"] = {"file": a.traces, "ours": split_by_final(tr, "ours"), "fetch": split_by_final(tr, "fetch")}
         result["step_response"] = resp
         result["slots"] = compare_slots(tr["ours_obs"], tr["fetch_obs"])
         print(f"traces: {a.traces} (same starts and goals in both; by final-step outcome in the JSON)")
-    write_json_atomic(out, result)
+    write_result(out, result)
     print(f"wrote {out}")
     return 0

@@ -70,6 +70,28 @@ def test_checkpoint_without_policy_is_one_line(tmp_path, capsys, monkeypatch):
     assert "holds no policy" in _error(capsys, [str(run), "--reference"])
 
 
+def test_traces_in_a_missing_directory_is_one_line_before_any_episode(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(cli, "scripted", lambda *a: pytest.fail("evaluated before the flags were checked"))
+    traces = str(tmp_path / "no" / "t.npz")
+    argv = ["--scripted", "reach", "--reference", "--out", str(tmp_path / "r.json"), "--traces", traces]
+    assert "--traces" in _error(capsys, argv)
+
+
+def test_result_written_when_its_directory_was_moved_away_meanwhile(tmp_path, capsys, monkeypatch):
+    out = tmp_path / "results" / "r.json"
+    out.parent.mkdir()
+    side = {"episodes": 1, "success_any": 1.0, "success_any_ci95": [0.2, 1.0], "success_final": 1.0,
+            "success_final_ci95": [0.2, 1.0], "median_final_distance": 0.01}  # fmt: skip
+
+    def evaluated_while_moved(*args):
+        out.parent.rename(tmp_path / "elsewhere")
+        return {"reference": "FetchReach-v4", "ours": side, "fetch": side}, {}
+
+    monkeypatch.setattr(cli, "scripted", evaluated_while_moved)
+    assert cli.main(["--scripted", "reach", "--reference", "--episodes", "1", "--out", str(out)]) == 0
+    assert json.loads(out.read_text())["fetch"]["success_final"] == 1.0
+
+
 def test_reference_flag_is_required(tmp_path, capsys):
     assert "--reference" in _error(capsys, [str(tmp_path)])
 
