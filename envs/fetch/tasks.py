@@ -32,7 +32,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs import small_cholesky, solver_loops
+from envs import fused_solver, small_cholesky, solver_loops
 from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
 from envs.fetch import models
 from splid_jax.common.errors import check, check_integer
@@ -42,8 +42,9 @@ _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4)
 GOAL_LIFT_MAX = 0.45
 GRASP_ABOVE_SITE = 0.01  # a grasped cube's centre above the grip site: inside the fingers' 6 cm height
 CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
-# MJX's solver loops, both written out, the line search alone written out, and each of the last two on a GPU only
-SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search")
+# MJX's solver loops, both written out, the line search alone written out, each of the last two on a GPU only, and
+# the whole solve as one program per env (envs/fused_solver.py)
+SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused")
 
 
 @struct.dataclass
@@ -107,7 +108,8 @@ class _FetchTask(GoalEnv):
     # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     cholesky: str = experimental("unrolled")
     # MJX's Newton solver as its loops, written out (unrolled), its line search alone written out (search),
-    # or either on a GPU only (auto, gpu-search; envs/solver_loops.py): equal to float rounding
+    # or either on a GPU only (auto, gpu-search; envs/solver_loops.py), or the whole solve one program per env, a
+    # Pallas kernel on a GPU (fused; envs/fused_solver.py): equal to float rounding
     solver_loops: str = experimental("gpu-search", numerics_only=True)
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
@@ -336,7 +338,9 @@ class _FetchTask(GoalEnv):
         newton, line_search = solver_loops.writes_out(self.solver_loops, jax.default_backend())
         with small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"):
             with solver_loops.unrolled_in_mjx(self.iterations, newton, line_search):
-                return mjx_substeps(model, data, phys.replace(ctrl=ctrl), self.substeps)
+                gpu = jax.default_backend() == "gpu"
+                with fused_solver.fused_in_mjx(self.solver_loops == "fused", kernel=gpu):
+                    return mjx_substeps(model, data, phys.replace(ctrl=ctrl), self.substeps)
 
     def _action(self, action: jax.Array) -> jax.Array:
         """The action (any leading batch axes) as the control law reads it: clipped to [-1, 1], the fingers'

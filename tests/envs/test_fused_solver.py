@@ -1,0 +1,77 @@
+"""MJX's Newton solve as one program per env: MJX's arithmetic to float rounding, its Pallas kernel the same
+function, and MJX's own solve for models it does not cover."""
+
+from __future__ import annotations
+
+import functools
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from mujoco.mjx._src import solver as mjx_solver
+
+import envs
+from envs import fused_solver
+
+
+@functools.cache
+def _path(choice: str) -> np.ndarray:
+    """qpos over six steps of four Push envs (one substep each) with MJX's solver as ``choice`` runs it."""
+    env = envs.make("push", substeps=1, solver_loops=choice)
+    state = jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, 4)))(jax.random.PRNGKey(0))
+    actions = jax.random.uniform(jax.random.PRNGKey(1), (6, 4, 4), minval=-1.0, maxval=1.0)
+
+    def step(s, a):
+        s = jax.vmap(env.step)(s, a)
+        return s, s.physics.qpos
+
+    return np.asarray(jax.jit(lambda s: jax.lax.scan(step, s, actions)[1])(state))
+
+
+def test_fused_solve_follows_mjx_path():
+    fused, loops = _path("fused"), _path("loops")
+    assert np.isfinite(fused).all()
+    np.testing.assert_allclose(fused, loops, atol=1e-5)
+
+
+def _problem(key, nefc=40, nv=9):
+    """A random solve with a third of the rows pushing against their constraint (negative aref)."""
+    k = jax.random.split(key, 6)
+    j = jax.random.normal(k[0], (nefc, nv))
+    a = jax.random.normal(k[1], (nv, nv))
+    m = a @ a.T + nv * jnp.eye(nv)
+    d = jax.random.uniform(k[2], (nefc,), minval=0.1, maxval=10.0)
+    aref = jax.random.normal(k[3], (nefc,)) - 0.3
+    qfrc_smooth, qacc_smooth = jax.random.normal(k[4], (2, nv))
+    qacc_warm = qacc_smooth + 0.1 * jax.random.normal(k[5], (nv,))
+    return j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, jnp.trace(m)
+
+
+def test_kernel_is_the_function_for_a_batch_of_envs():
+    opts = dict(iterations=4, ls_iterations=4, tolerance=1e-8, ls_tolerance=0.01)
+    problems = jax.vmap(_problem)(jax.random.split(jax.random.PRNGKey(0), 3))
+    plain = jax.jit(jax.vmap(functools.partial(fused_solver.newton, **opts)))(*problems)
+    kernel = jax.jit(jax.vmap(functools.partial(fused_solver.kernel_solve, interpret=True, **opts)))(*problems)
+    assert float(jnp.abs(plain[2]).max()) > 0  # some rows push
+    for got, want in zip(kernel, plain, strict=True):
+        np.testing.assert_allclose(got, want, rtol=1e-5, atol=1e-5)
+
+
+def test_masked_cholesky_solves_the_system():
+    j, _, _, m, b, *_ = _problem(jax.random.PRNGKey(2))
+    np.testing.assert_allclose(fused_solver.chol_solve(m, b), jnp.linalg.solve(m, b), rtol=1e-5, atol=1e-6)
+
+
+def test_mjx_solve_kept_outside_the_block_and_for_models_not_covered():
+    from mujoco import mjx
+    from mujoco.mjx._src.types import ConeType
+
+    model = envs.make("push").mjx_model
+    data = mjx.make_data(model)  # the constraint rows' shapes are all ``covers`` reads
+    assert fused_solver.covers(model, data)
+    elliptic = model.replace(opt=model.opt.replace(cone=ConeType.ELLIPTIC))
+    assert not fused_solver.covers(elliptic, data)
+    before = mjx_solver.solve
+    with fused_solver.fused_in_mjx():
+        assert mjx_solver.solve is not before
+    assert mjx_solver.solve is before
