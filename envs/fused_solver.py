@@ -123,11 +123,11 @@ def newton(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *, itera
         dmag = 2.0 * jnp.sqrt(rows_0 * rows_2) + jnp.abs(g1)
         gacc = jnp.maximum(gtol, 8 * jnp.finfo(j.dtype).eps * dmag)
 
+        def converged(lo, hi):
+            return ((jnp.abs(lo[2]) < gacc) & (lo[1] < p0[1])) | ((jnp.abs(hi[2]) < gacc) & (hi[1] < p0[1]))
+
         def cond(lo, hi, swap, it):
-            done = (it >= ls_iterations) | ~swap
-            done |= (jnp.abs(lo[2]) < gacc) & (lo[1] < p0[1])
-            done |= (jnp.abs(hi[2]) < gacc) & (hi[1] < p0[1])
-            return ~done
+            return ~((it >= ls_iterations) | ~swap | converged(lo, hi))
 
         def inb(x, y):
             return ((x < y) & (y < 0)) | ((x > y) & (y > 0))
@@ -167,7 +167,8 @@ def newton(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *, itera
             swap, it = jnp.where(go, nswap, swap), jnp.where(go, nit, it)
             return lo, hi, swap, it, go & cond(lo, hi, swap, it)
 
-        lo, hi, *_ = jax.lax.fori_loop(0, ls_iterations, trip, (lo, hi, swap, it, cond(lo, hi, swap, it)))
+        go = ~converged(lo, hi)  # the condition before the first trip (swap set, no trip taken): no literal in it
+        lo, hi, *_ = jax.lax.fori_loop(0, ls_iterations, trip, (lo, hi, swap, it, go))
         improved = (lo[1] < p0[1]) | (hi[1] < p0[1])
         step = improved * jnp.where(lo[1] < hi[1], lo[0], hi[0])
         return {**c, "qacc": c["qacc"] + step * search, "ma": c["ma"] + step * mv, "jaref": c["jaref"] + step * jv}
@@ -194,9 +195,11 @@ def _pow2(n: int) -> int:
 
 
 def kernel_solve(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *, interpret: bool = False, **opts):
-    """``newton`` for one env as one Pallas kernel (``vmap`` makes the envs its grid); ``interpret`` runs the
-    kernel's program with XLA, as on a CPU."""
+    """``newton`` for one env as one Pallas kernel (``vmap`` makes the envs its grid), lowered through Triton
+    (Mosaic GPU, Pallas's other GPU backend, takes no ``vmap``); ``interpret`` runs the kernel's program with
+    XLA, as on a CPU."""
     from jax.experimental import pallas as pl
+    from jax.experimental.pallas import triton as pl_triton
 
     nefc, nv = j.shape
     p, v = _pow2(max(nefc, 16)), _pow2(max(nv, 16))
@@ -218,6 +221,7 @@ def kernel_solve(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *,
         kernel,
         out_shape=(jax.ShapeDtypeStruct((v,), f32), jax.ShapeDtypeStruct((v,), f32), jax.ShapeDtypeStruct((p,), f32)),
         interpret=interpret,
+        compiler_params=pl_triton.CompilerParams(),
     )(jp_, pad_r(d), pad_r(aref), mp, pad_v(qfrc_smooth), pad_v(qacc_smooth), pad_v(qacc_warm), tr)
     qacc, qfrc, force = out
     return qacc[:nv], qfrc[:nv], force[:nefc]

@@ -75,3 +75,13 @@ def test_mjx_solve_kept_outside_the_block_and_for_models_not_covered():
     with fused_solver.fused_in_mjx():
         assert mjx_solver.solve is not before
     assert mjx_solver.solve is before
+
+
+def test_kernel_lowers_through_triton_as_one_call_for_a_batch():
+    # lowered for a GPU on this host (Pallas's Triton lowering needs no device): a construct Triton cannot
+    # hold fails here, not first on a GPU machine
+    opts = dict(iterations=4, ls_iterations=4, tolerance=1e-8, ls_tolerance=0.01)
+    problems = jax.vmap(functools.partial(_problem, nefc=56))(jax.random.split(jax.random.PRNGKey(0), 8))
+    solve = jax.vmap(functools.partial(fused_solver.kernel_solve, **opts))
+    text = jax.jit(solve).trace(*problems).lower(lowering_platforms=("cuda",)).as_text()
+    assert text.count("xla.gpu.triton") == 1 and "grid_x = 8" in text
