@@ -32,14 +32,16 @@ def _pick(x, mask):
     return jnp.sum(jnp.where(mask, x, 0.0))
 
 
-def chol_solve(a, b):
+def chol_solve(a, b, size: int | None = None):
     """x with a x = b for a symmetric positive definite [n, n] ``a``: Cholesky-Banachiewicz, rows and columns
-    picked with masks."""
+    picked with masks. Only the first ``size`` rows and columns are solved for; the rest of ``a`` must be the
+    identity (no coupling) and of ``b`` zero, as padding leaves them."""
     n = a.shape[0]
+    size = n if size is None else size
     i = jnp.arange(n)[:, None]
     j = jnp.arange(n)[None, :]
     low = jnp.zeros_like(a)
-    for k in range(n):  # column k of L from the columns before it
+    for k in range(size):  # column k of L from the columns before it
         row_k = jnp.sum(jnp.where(i == k, low, 0.0), axis=0)  # L[k, :]
         s = jnp.sum(jnp.where(j < k, low * row_k[None, :], 0.0), axis=1)  # sum_{m<k} L[:, m] L[k, m]
         col = jnp.sum(jnp.where(j == k, a, 0.0), axis=1) - s  # a[:, k] - s
@@ -49,12 +51,12 @@ def chol_solve(a, b):
     ii = jnp.arange(n)
     diag = jnp.sum(jnp.where(i == j, low, 0.0), axis=1)
     y = jnp.zeros_like(b)
-    for k in range(n):  # forward: L y = b
+    for k in range(size):  # forward: L y = b
         row_k = jnp.sum(jnp.where(i == k, low, 0.0), axis=0)
         yk = (_pick(b, ii == k) - jnp.sum(jnp.where(ii < k, row_k * y, 0.0))) / _pick(diag, ii == k)
         y = jnp.where(ii == k, yk, y)
     x = jnp.zeros_like(b)
-    for k in reversed(range(n)):  # backward: L^T x = y
+    for k in reversed(range(size)):  # backward: L^T x = y
         col_k = jnp.sum(jnp.where(j == k, low, 0.0), axis=1)  # L[:, k]
         xk = (_pick(y, ii == k) - jnp.sum(jnp.where(ii > k, col_k * x, 0.0))) / _pick(diag, ii == k)
         x = jnp.where(ii == k, xk, x)
@@ -75,9 +77,10 @@ def _dot_tn(a, b):
 
 
 def newton(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *, iterations, ls_iterations, tolerance,
-           ls_tolerance):  # fmt: skip
+           ls_tolerance, dofs: int | None = None):  # fmt: skip
     """(qacc, qfrc_constraint, efc_force) as mujoco.mjx._src.solver.solve computes them for these models.
-    Line-search points are 4-tuples (alpha, cost, deriv_0, deriv_1), as MJX's _LSPoint."""
+    Line-search points are 4-tuples (alpha, cost, deriv_0, deriv_1), as MJX's _LSPoint. ``dofs``: the dofs
+    before the padding, so the Hessian's factor skips the padded (decoupled) ones."""
 
     def gauss_of(ma, qacc):
         return 0.5 * jnp.sum((ma - qfrc_smooth) * (qacc - qacc_smooth))
@@ -98,7 +101,7 @@ def newton(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *, itera
         grad = c["ma"] - qfrc_smooth - c["qfrc"]
         h = m + _dot_tn(j * (d * c["active"])[:, None], j)
         h = (h + h.T) * 0.5
-        return {**c, "grad": grad, "mgrad": chol_solve(h, grad)}
+        return {**c, "grad": grad, "mgrad": chol_solve(h, grad, dofs)}
 
     def linesearch(c):
         search = c["search"]
@@ -212,7 +215,7 @@ def kernel_solve(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *,
 
     def kernel(j_ref, d_ref, aref_ref, m_ref, qfs_ref, qas_ref, qaw_ref, tr_ref, qacc_ref, qfrc_ref, force_ref):
         qacc, qfrc, force = newton(j_ref[...], d_ref[...], aref_ref[...], m_ref[...], qfs_ref[...], qas_ref[...],
-                                   qaw_ref[...], jnp.max(tr_ref[...]), **opts)  # fmt: skip
+                                   qaw_ref[...], jnp.max(tr_ref[...]), dofs=nv, **opts)  # fmt: skip
         qacc_ref[...] = qacc
         qfrc_ref[...] = qfrc
         force_ref[...] = force
