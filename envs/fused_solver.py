@@ -21,7 +21,7 @@ import jax
 import jax.numpy as jnp
 from mujoco.mjx._src import solver as mjx_solver
 from mujoco.mjx._src import support
-from mujoco.mjx._src.types import ConeType, SolverType
+from mujoco.mjx._src.types import ConeType, DisableBit, SolverType
 
 from envs.small_cholesky import TRACE_LOCK
 
@@ -231,7 +231,8 @@ def kernel_solve(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *,
 
 
 def covers(m, d) -> bool:
-    """Whether ``newton`` is MJX's solve for this model: Newton, pyramidal cones, only inequality rows."""
+    """Whether ``newton`` is MJX's solve for this model: Newton, pyramidal cones, only inequality rows, warm
+    started."""
     impl = d._impl
     friction_loss = bool(m._impl.dof_hasfrictionloss.any() or m._impl.tendon_hasfrictionloss.any())
     return (
@@ -242,6 +243,7 @@ def covers(m, d) -> bool:
         and not friction_loss
         and impl.efc_J.shape[0] > 0
         and m.opt.iterations >= 1
+        and not m.opt.disableflags & DisableBit.WARMSTART
     )
 
 

@@ -64,13 +64,15 @@ def test_masked_cholesky_solves_the_system():
 
 def test_mjx_solve_kept_outside_the_block_and_for_models_not_covered():
     from mujoco import mjx
-    from mujoco.mjx._src.types import ConeType
+    from mujoco.mjx._src.types import ConeType, DisableBit
 
     model = envs.make("push").mjx_model
     data = mjx.make_data(model)  # the constraint rows' shapes are all ``covers`` reads
     assert fused_solver.covers(model, data)
     elliptic = model.replace(opt=model.opt.replace(cone=ConeType.ELLIPTIC))
     assert not fused_solver.covers(elliptic, data)
+    cold = model.replace(opt=model.opt.replace(disableflags=model.opt.disableflags | DisableBit.WARMSTART))
+    assert not fused_solver.covers(cold, data)
     before = mjx_solver.solve
     with fused_solver.fused_in_mjx():
         assert mjx_solver.solve is not before
