@@ -197,10 +197,11 @@ def _pow2(n: int) -> int:
     return 1 << max(0, (n - 1).bit_length())
 
 
-def kernel_solve(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *, interpret: bool = False, **opts):
+def kernel_solve(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *, interpret: bool = False,
+                 num_warps: int | None = None, **opts):  # fmt: skip
     """``newton`` for one env as one Pallas kernel (``vmap`` makes the envs its grid), lowered through Triton
-    (Mosaic GPU, Pallas's other GPU backend, takes no ``vmap``); ``interpret`` runs the kernel's program with
-    XLA, as on a CPU."""
+    (Mosaic GPU, Pallas's other GPU backend, takes no ``vmap``) with ``num_warps`` warps per env (Triton's
+    default 4 when None); ``interpret`` runs the kernel's program with XLA, as on a CPU."""
     from jax.experimental import pallas as pl
     from jax.experimental.pallas import triton as pl_triton
 
@@ -224,7 +225,7 @@ def kernel_solve(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *,
         kernel,
         out_shape=(jax.ShapeDtypeStruct((v,), f32), jax.ShapeDtypeStruct((v,), f32), jax.ShapeDtypeStruct((p,), f32)),
         interpret=interpret,
-        compiler_params=pl_triton.CompilerParams(),
+        compiler_params=pl_triton.CompilerParams(num_warps=num_warps),
     )(jp_, pad_r(d), pad_r(aref), mp, pad_v(qfrc_smooth), pad_v(qacc_smooth), pad_v(qacc_warm), tr)
     qacc, qfrc, force = out
     return qacc[:nv], qfrc[:nv], force[:nefc]
@@ -247,7 +248,7 @@ def covers(m, d) -> bool:
     )
 
 
-def solve(m, d, kernel: bool):
+def solve(m, d, kernel: bool, num_warps: int | None = None):
     """``mujoco.mjx._src.solver.solve`` for the models ``covers`` takes, through ``kernel_solve`` if ``kernel``."""
     if not covers(m, d):
         return _MJX_SOLVE(m, d)
@@ -255,7 +256,7 @@ def solve(m, d, kernel: bool):
                 tolerance=float(m.opt.tolerance), ls_tolerance=float(m.opt.ls_tolerance))  # fmt: skip
     args = (d._impl.efc_J, d._impl.efc_D, d._impl.efc_aref, support.full_m(m, d), d.qfrc_smooth, d.qacc_smooth,
             d.qacc_warmstart, mjx_solver._trace_m(m, d))  # fmt: skip
-    qacc, qfrc, force = kernel_solve(*args, **opts) if kernel else newton(*args, **opts)
+    qacc, qfrc, force = kernel_solve(*args, num_warps=num_warps, **opts) if kernel else newton(*args, **opts)
     return d.tree_replace({"qfrc_constraint": qfrc, "qacc": qacc, "_impl.efc_force": force})
 
 
