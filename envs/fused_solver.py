@@ -201,7 +201,8 @@ def kernel_solve(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *,
                  num_warps: int | None = None, **opts):  # fmt: skip
     """``newton`` for one env as one Pallas kernel (``vmap`` makes the envs its grid), lowered through Triton
     (Mosaic GPU, Pallas's other GPU backend, takes no ``vmap``) with ``num_warps`` warps per env (Triton's
-    default 4 when None); ``interpret`` runs the kernel's program with XLA, as on a CPU."""
+    default 4 when None); ``interpret`` runs the kernel's program with XLA, as on a CPU. Each enclosing ``vmap``
+    is an axis of the grid, and Triton's grid has three: a sweep's members over a step's envs use two."""
     from jax.experimental import pallas as pl
     from jax.experimental.pallas import triton as pl_triton
 
