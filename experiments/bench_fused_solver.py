@@ -34,7 +34,7 @@ with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on i
     from mujoco.mjx._src import solver as mjx_solver
 
 import envs  # noqa: E402
-from envs import fused_solver, small_cholesky, solver_loops  # noqa: E402
+from envs import fused_solver, small_cholesky  # noqa: E402
 from envs.fetch.scripted import CONTROLLERS  # noqa: E402
 
 
@@ -49,11 +49,12 @@ def presolve_states(env, batch: int, steps: int, seed: int):
 
     def before_solve(p):
         data = mjx.make_data(model).replace(**{n: getattr(p, n) for n in names})
-        with contextlib.ExitStack() as stack:
-            stack.enter_context(small_cholesky.TRACE_LOCK)
+        with small_cholesky.TRACE_LOCK:  # MJX's forward dynamics with its solve left out
             saved, mjx_solver.solve = mjx_solver.solve, lambda m, d: d
-            stack.callback(setattr, mjx_solver, "solve", saved)
-            return mjx_forward.forward(model, data)
+            try:
+                return mjx_forward.forward(model, data)
+            finally:
+                mjx_solver.solve = saved
 
     return jax.jit(jax.vmap(before_solve))(phys)
 
@@ -96,12 +97,10 @@ def main() -> None:
     env = envs.make(a.task)
     model = env.mjx_model
     gpu = jax.default_backend() == "gpu"
-    newton, line_search = solver_loops.writes_out(env.solver_loops, jax.default_backend())
 
     def mjx_solve(d):
-        with small_cholesky.unrolled_in_mjx(env.cholesky == "unrolled"):
-            with solver_loops.unrolled_in_mjx(env.iterations, newton, line_search):
-                return mjx_solver.solve(model, d)
+        with env.solver_in_mjx():  # the task's default solver_loops: MJX's own solve
+            return mjx_solver.solve(model, d)
 
     variants = {f"mjx ({env.solver_loops})": mjx_solve}
     if gpu:

@@ -26,6 +26,7 @@ rounding and slower on a GPU).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 
 import jax
@@ -335,12 +336,21 @@ class _FetchTask(GoalEnv):
         if self.drive == "weld":  # the constraint pulls the gripper to the mocap body, put at the target
             home = jnp.asarray(self.layout.grip_home, data.mocap_pos.dtype)
             data = data.replace(mocap_pos=data.mocap_pos.at[0].set(home + ctrl[0:3]))
-        newton, line_search = solver_loops.writes_out(self.solver_loops, jax.default_backend())
-        with small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"):
-            with solver_loops.unrolled_in_mjx(self.iterations, newton, line_search):
-                gpu = jax.default_backend() == "gpu"
-                with fused_solver.fused_in_mjx(self.solver_loops == "fused", kernel=gpu):
-                    return mjx_substeps(model, data, phys.replace(ctrl=ctrl), self.substeps)
+        with self.solver_in_mjx():
+            return mjx_substeps(model, data, phys.replace(ctrl=ctrl), self.substeps)
+
+    @contextlib.contextmanager
+    def solver_in_mjx(self):
+        """Within the block (a trace of MJX calls), MJX factors and solves as this task's ``cholesky`` and
+        ``solver_loops`` choose, on the backend being traced for."""
+        backend = jax.default_backend()
+        newton, line_search = solver_loops.writes_out(self.solver_loops, backend)
+        with (
+            small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"),
+            solver_loops.unrolled_in_mjx(self.iterations, newton, line_search),
+            fused_solver.fused_in_mjx(self.solver_loops == "fused", kernel=backend == "gpu"),
+        ):
+            yield
 
     def _action(self, action: jax.Array) -> jax.Array:
         """The action (any leading batch axes) as the control law reads it: clipped to [-1, 1], the fingers'
