@@ -10,7 +10,10 @@ with MJX's to float rounding; other models keep MJX's solve.
 
 Written for what a Triton kernel holds: no gathers or dynamic indexing (the Cholesky factor and the triangular
 solves pick rows and columns with masks), shapes padded to powers of two (padded constraint rows have D = 0 and
-J = 0, so they are never active; padded dofs get unit mass and no force), line-search points as tuples of scalars.
+J = 0, so they are never active; padded dofs get unit mass and no force), line-search points as tuples of scalars,
+and no while loop (XLA's Triton compiler crashed on the kernel with MJX's Newton while loop in it): the Newton
+trips, like the line search's, are a fixed-count loop that keeps a trip's result only where MJX's loop would
+still be running.
 """
 
 from __future__ import annotations
@@ -194,7 +197,13 @@ def newton(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *, itera
         c = gradient(constraint(linesearch(c), c["cost"]))
         return {**c, "search": -c["mgrad"], "niter": c["niter"] + 1}
 
-    c = nbody(c) if iterations == 1 else jax.lax.while_loop(ncond, nbody, c)
+    def trip(_, carry):  # a Newton trip runs while MJX's while loop would; a fixed count, as Triton compiles it
+        c, go = carry
+        c = jax.tree.map(lambda new, old: jnp.where(go, new, old), nbody(c), c)
+        return c, go & ncond(c)
+
+    first = jnp.array(True) if iterations == 1 else ncond(c)  # MJX runs a single trip unconditionally
+    c, _ = jax.lax.fori_loop(0, iterations, trip, (c, first))
     return c["qacc"], c["qfrc"], c["force"]
 
 
@@ -252,6 +261,12 @@ def covers(m, d) -> bool:
         and m.opt.iterations >= 1
         and not m.opt.disableflags & DisableBit.WARMSTART
     )
+
+
+def chosen(choice: str, backend: str) -> bool:
+    """Whether a task's ``solver_loops`` choice solves through ``solve`` on ``backend``: ``fused`` always,
+    ``gpu-fused`` on a GPU only (on a CPU the kernel runs as XLA code, slower than MJX's loops)."""
+    return choice == "fused" or (choice == "gpu-fused" and backend == "gpu")
 
 
 def solve(m, d, kernel: bool, num_warps: int | None = None):

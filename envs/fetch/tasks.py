@@ -45,7 +45,7 @@ GRASP_ABOVE_SITE = 0.01  # a grasped cube's centre above the grip site: inside t
 CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
 # MJX's solver loops, both written out, the line search alone written out, each of the last two on a GPU only, and
 # the whole solve as one program per env (envs/fused_solver.py)
-SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused")
+SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused", "gpu-fused")
 
 
 @struct.dataclass
@@ -110,7 +110,8 @@ class _FetchTask(GoalEnv):
     cholesky: str = experimental("unrolled")
     # MJX's Newton solver as its loops, written out (unrolled), its line search alone written out (search),
     # or either on a GPU only (auto, gpu-search; envs/solver_loops.py), or the whole solve one program per env, a
-    # Pallas kernel on a GPU (fused; envs/fused_solver.py): equal to float rounding
+    # Pallas kernel on a GPU (fused; on a GPU only, MJX's loops on a CPU: gpu-fused; envs/fused_solver.py):
+    # equal to float rounding
     solver_loops: str = experimental("gpu-search", numerics_only=True)
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
@@ -348,7 +349,7 @@ class _FetchTask(GoalEnv):
         with (
             small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"),
             solver_loops.unrolled_in_mjx(self.iterations, newton, line_search),
-            fused_solver.fused_in_mjx(self.solver_loops == "fused", kernel=backend == "gpu"),
+            fused_solver.fused_in_mjx(fused_solver.chosen(self.solver_loops, backend), kernel=backend == "gpu"),
         ):
             yield
 
@@ -392,6 +393,8 @@ class Push(_FetchTask):
 
     finger_table: float = 1.0
     finger: str = "pads"
+    # the solve as one kernel on a GPU, where Push's step was measured twice as fast (BENCHMARKS.md)
+    solver_loops: str = experimental("gpu-fused", numerics_only=True)
     kind = "push"
 
 

@@ -87,3 +87,38 @@ def test_kernel_lowers_through_triton_as_one_call_for_a_batch():
     solve = jax.vmap(functools.partial(fused_solver.kernel_solve, **opts))
     text = jax.jit(solve).trace(*problems).lower(lowering_platforms=("cuda",)).as_text()
     assert text.count("xla.gpu.triton") == 1 and "grid_x = 8" in text
+
+
+def _primitives(jaxpr) -> set[str]:
+    """Every primitive in ``jaxpr`` and the jaxprs inside its equations (loop bodies, branches)."""
+    names = set()
+    for eqn in jaxpr.eqns:
+        names.add(eqn.primitive.name)
+        for value in eqn.params.values():
+            for sub in value if isinstance(value, tuple | list) else (value,):
+                inner = getattr(sub, "jaxpr", sub)
+                if hasattr(inner, "eqns"):
+                    names |= _primitives(inner)
+    return names
+
+
+def test_solve_has_no_while_loop():
+    # XLA's Triton compiler on a GPU crashed (segmentation fault) on kernels holding a while loop; the
+    # Newton trips and line searches are fixed-count loops with their conditions as masks
+    opts = dict(iterations=4, ls_iterations=4, tolerance=1e-8, ls_tolerance=0.01)
+    jaxpr = jax.make_jaxpr(functools.partial(fused_solver.newton, **opts))(*_problem(jax.random.PRNGKey(3)))
+    names = _primitives(jaxpr.jaxpr)
+    assert "scan" in names and "while" not in names
+
+
+def test_push_default_solves_through_the_kernel_on_a_gpu_only(monkeypatch):
+    env = envs.make("push", substeps=1)
+    state = jax.eval_shape(jax.vmap(env.reset), jax.random.split(jax.random.PRNGKey(0), 4))
+    actions = jax.ShapeDtypeStruct((4, 4), jnp.float32)
+    cpu = jax.jit(lambda s, a: jax.vmap(env.step)(s, a)).trace(state, actions).lower().as_text()
+    assert "triton" not in cpu
+    monkeypatch.setattr(jax, "default_backend", lambda: "gpu")
+    gpu = jax.jit(lambda s, a: jax.vmap(env.step)(s, a)).trace(state, actions).lower(lowering_platforms=("cuda",))
+    assert gpu.as_text().count("xla.gpu.triton") == 1
+    assert [fused_solver.chosen("gpu-fused", b) for b in ("gpu", "cpu")] == [True, False]
+    assert fused_solver.chosen("fused", "cpu") and not fused_solver.chosen("gpu-search", "gpu")
