@@ -102,9 +102,7 @@ LEARNERS: dict[str, Learner] = {
             options="her_options",
             task_defaults={
                 "reach": {**_HER_FETCH, "iterations": 250},
-                # the solver written out on a GPU, where its rollout of 16 envs is latency-bound: 1.40x per cycle
-                # for 25 s of compile on one H100 (BENCHMARKS.md, "Time budget per stage"); equal to float rounding
-                "push": {**_HER_FETCH, "iterations": 1250, "env_options": "solver_loops=auto"},
+                "push": {**_HER_FETCH, "iterations": 1250},
                 "slide": {**_HER_FETCH, "iterations": 3200},
                 "pick_and_place": {**_HER_FETCH, "iterations": 3200},
             },

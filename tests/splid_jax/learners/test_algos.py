@@ -109,7 +109,7 @@ def test_her_takes_its_own_defaults_on_fetch_tasks_only():
     assert (push.num_envs, push.eval_every, push.iterations * push.num_envs) == (16, 50, 20_000)
     assert TrainConfig(env="push").num_envs == 125 and TrainConfig(env="point", algo="her").num_envs == 32
     assert TrainConfig(env="push", algo="her", num_envs=32).num_envs == 32  # given values win
-    assert push.env_overrides() == {"solver_loops": "auto"} and TrainConfig(env="push").env_options == ""
+    assert push.env_overrides() == {} and TrainConfig(env="push").env_options == ""
     given = TrainConfig(env="push", algo="her", env_options="finger=box,solver_loops=loops")
     assert given.env_overrides() == {"finger": "box", "solver_loops": "loops"}  # option by option, given ones win
     carry = TrainConfig(env="pick_and_place", algo="her").env_overrides()  # the task's own options stay
@@ -122,4 +122,4 @@ def test_help_lists_each_learners_fields_and_defaults(capsys):
     text = " ".join(capsys.readouterr().out.split())
     assert "batch_size=2048 (" in text and "replay_k=4 (" in text and "population=256 (" in text
     assert "her on reach, push, slide, pick_and_place: 16" in text
-    assert "her on push: solver_loops=auto" in text
+    assert "her on push: 1250" in text
