@@ -28,6 +28,7 @@ import jax.numpy as jnp
 import numpy as np
 
 import envs
+from envs import fused_solver
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 from splid_jax.learners import registry
@@ -272,7 +273,13 @@ class _Loop:
         self.show(f"compiling the training program ({compile_hint(self.env)}; "
                   "less when the compile cache holds it)...")  # fmt: skip
         t0 = time.perf_counter()
-        compiled = self.signals.wait(lambda: traced.lower().compile())
+        try:
+            compiled = self.signals.wait(lambda: traced.lower().compile())
+        except Exception as e:  # re-raised unless it is the solve kernel's
+            hint = fused_solver.kernel_failure(self.env, e)
+            if hint is None:
+                raise
+            raise InvalidConfig("env_options", cfg.env_options, hint) from e
         analysis = compiled.memory_analysis()
         if groups is not None:
             compiled = groups.compile(compiled, lambda dev: jax.jit(chunk).trace(

@@ -122,3 +122,12 @@ def test_push_default_solves_through_the_kernel_on_a_gpu_only(monkeypatch):
     assert gpu.as_text().count("xla.gpu.triton") == 1
     assert [fused_solver.chosen("gpu-fused", b) for b in ("gpu", "cpu")] == [True, False]
     assert fused_solver.chosen("fused", "cpu") and not fused_solver.chosen("gpu-search", "gpu")
+
+
+def test_a_kernel_compile_failure_names_the_option_that_avoids_it():
+    error = RuntimeError("INTERNAL: Triton compilation failed\nmore")
+    hint = fused_solver.kernel_failure(envs.make("push"), error)
+    assert "solver_loops=gpu-search" in hint and "Triton compilation failed" in hint and "more" not in hint
+    assert fused_solver.kernel_failure(envs.make("push"), RuntimeError("RESOURCE_EXHAUSTED: out of memory")) is None
+    assert fused_solver.kernel_failure(envs.make("push", solver_loops="gpu-search"), error) is None
+    assert fused_solver.kernel_failure(envs.make("point"), error) is None

@@ -401,3 +401,16 @@ def test_a_full_disk_is_one_line_exit_3_and_keeps_the_last_whole_checkpoint(tmp_
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "no space left" in err and "iteration 5 is kept" in err
     assert checkpoint.latest_step(str(run_dir)) == 5
+
+
+def test_a_gpu_compiler_failing_on_the_solve_kernel_is_one_line(tmp_path, capsys, monkeypatch):
+    from envs import fused_solver
+
+    def compile_fails(self):
+        raise RuntimeError("INTERNAL: Triton compilation failed for the kernel\n(a long log)")
+
+    monkeypatch.setattr(jax.stages.Lowered, "compile", compile_fails)
+    monkeypatch.setattr(fused_solver, "kernel_failure", lambda task, e: "another solver (" + str(e).split()[1] + ")")
+    assert main([*TINY, "--iterations", "5", "--run-dir", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "env_options" in err and "another solver (Triton)" in err
