@@ -44,7 +44,7 @@ GOAL_LIFT_MAX = 0.45
 GRASP_ABOVE_SITE = 0.01  # a grasped cube's centre above the grip site: inside the fingers' 6 cm height
 CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
 # MJX's solver loops, both written out, the line search alone written out, each of the last two on a GPU only, and
-# the whole solve as one program per env (envs/fused_solver.py)
+# the whole solve as one program per env (envs/fused_solver.py), always or on a GPU only
 SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused", "gpu-fused")
 
 

@@ -87,7 +87,7 @@ def check_memory(need: int, what: str, device, cfg: TrainConfig, members: int) -
 def compile_hint(env: envs.GoalEnv) -> str:
     """Roughly how long the first compilation takes for this kind of task."""
     if type(env).__module__.startswith("envs.fetch"):
-        return "about 3 minutes for a Fetch task on a 2-core CPU, under a minute on a GPU"
+        return "1 to 3 minutes for a Fetch task on a 2-core CPU, under a minute on a GPU"
     if hasattr(type(env), "mj_model"):  # the other MuJoCo (MJX) tasks: a smaller model than Fetch's
         return "about a minute for an MJX task on a 2-core CPU, less on a GPU"
     return "about 15 s on a 2-core CPU, a few seconds on a GPU"
