@@ -33,7 +33,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs import fused_solver, small_cholesky, solver_loops
+from envs import fused_collision, fused_solver, small_cholesky, solver_loops
 from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
 from envs.fetch import models
 from splid_jax.common.errors import check, check_integer
@@ -46,6 +46,7 @@ CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linal
 # MJX's solver loops, both written out, the line search alone written out, each of the last two on a GPU only, and
 # the whole solve as one program per env (envs/fused_solver.py), always or on a GPU only
 SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused", "gpu-fused")
+COLLISION = ("mjx", "fused", "gpu-fused")  # box-box contacts: MJX's, or envs/fused_collision.py always or on a GPU
 
 
 @struct.dataclass
@@ -113,6 +114,9 @@ class _FetchTask(GoalEnv):
     # Pallas kernel on a GPU (fused; on a GPU only, MJX's loops on a CPU: gpu-fused; envs/fused_solver.py):
     # equal to float rounding
     solver_loops: str = experimental("gpu-search", numerics_only=True)
+    # box-box contacts as MJX computes them, or as one program per pair, a Pallas kernel on a GPU (fused; on a GPU
+    # only: gpu-fused; envs/fused_collision.py): the same contacts up to MJX's float ties
+    collision: str = experimental("mjx", numerics_only=True)
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
     # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
@@ -159,6 +163,8 @@ class _FetchTask(GoalEnv):
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
         ok = self.solver_loops in SOLVER_LOOPS
         check(ok, f"{n}.solver_loops", self.solver_loops, "one of " + ", ".join(SOLVER_LOOPS))
+        ok = self.collision in COLLISION
+        check(ok, f"{n}.collision", self.collision, "one of " + ", ".join(COLLISION))
         grasp_range = "in [0, 1]" if not self.block_gripper else "0 (the fingers are locked on this task)"
         ok = 0 <= self.grasped_starts <= 1 and (self.grasped_starts == 0 or not self.block_gripper)
         check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
@@ -342,14 +348,15 @@ class _FetchTask(GoalEnv):
 
     @contextlib.contextmanager
     def solver_in_mjx(self):
-        """Within the block (a trace of MJX calls), MJX factors and solves as this task's ``cholesky`` and
-        ``solver_loops`` choose, on the backend being traced for."""
+        """Within the block (a trace of MJX calls), MJX factors, solves and collides boxes as this task's
+        ``cholesky``, ``solver_loops`` and ``collision`` choose, on the backend being traced for."""
         backend = jax.default_backend()
         newton, line_search = solver_loops.writes_out(self.solver_loops, backend)
         with (
             small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"),
             solver_loops.unrolled_in_mjx(self.iterations, newton, line_search),
             fused_solver.fused_in_mjx(fused_solver.chosen(self.solver_loops, backend), kernel=backend == "gpu"),
+            fused_collision.fused_in_mjx(fused_collision.chosen(self.collision, backend), kernel=backend == "gpu"),
         ):
             yield
 

@@ -1,0 +1,378 @@
+"""MJX's box-box contacts (``mujoco.mjx._src.collision_convex.box_box``) as one program per box pair, and on a GPU
+as one Pallas kernel.
+
+Why: after the constraint solve (``envs/fused_solver.py``), collision is the largest part of a Push control step on a
+GPU (about 530 small kernels of its 2,600 at 16 envs before the solve kernel; BENCHMARKS.md, "Time budget per stage"),
+and of MJX's collision for Push the box-box pair (the finger block against the cube) is 1,111 of its 1,612 traced
+equations. The arithmetic is MJX's: the separating-axis test over the 6 + 6 face normals and 9 edge crosses, the
+reference and incident faces, their clipping, the choice of four manifold points, the edge-contact rule.
+
+Written for what a Triton kernel holds: vectors as (x, y, z) tuples of arrays, no gathers (picks by masks), argmax
+and argmin as the first index of the extreme, no concatenation, no constant arrays (vertices and faces from iota),
+shapes padded to powers of two; the clipped points keep a (set, edge, end) layout of shape (2, 4, 2) in MJX's order.
+Where MJX's choice is a float tie (boxes face to face: two equally deep points, two equally good fourth points) the
+rounding of either implementation decides, so the contacts agree as a set, their order or a duplicated point may
+differ; under MJX's own solver variants a Push path parts in the same way (``tests/envs/test_fused_collision.py``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from envs.small_cholesky import TRACE_LOCK
+
+_FACE = np.array([0, 4, 5, 1, 0, 2, 6, 4, 6, 7, 5, 4, 2, 3, 7, 6, 1, 5, 7, 3, 0, 1, 3, 2]).reshape(6, 4)
+_NORMAL = np.array([[0, -1, 0], [0, 0, -1], [1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0]], dtype=np.float32)
+NF, NA, BIG = 8, 32, 1e30  # faces padded to 8, separating axes (6 + 6 + 9 = 21) padded to 32
+
+
+def _v(a):
+    return tuple(a[..., i] for i in range(3))
+
+
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def add(a, b):
+    return tuple(x + y for x, y in zip(a, b, strict=True))
+
+
+def sub(a, b):
+    return tuple(x - y for x, y in zip(a, b, strict=True))
+
+
+def scale(a, s):
+    return tuple(x * s for x in a)
+
+
+def where(c, a, b):
+    return tuple(jnp.where(c, x, y) for x, y in zip(a, b, strict=True))
+
+
+def normalize(a):
+    n = jnp.sqrt(dot(a, a))
+    d = jnp.where(n == 0.0, n + 1e-6, n)
+    return tuple(x / d for x in a)
+
+
+def matvec(m, v):  # m as rows
+    return tuple(dot(row, v) for row in m)
+
+
+def first_index(mask, index):
+    """The smallest ``index`` where ``mask`` holds (argmax's and argmin's first occurrence)."""
+    return jnp.min(jnp.where(mask, index, 1 << 20))
+
+
+def argmin(x, index):
+    return first_index(x == jnp.min(x), index)
+
+
+def argmax(x, index):
+    return first_index(x == jnp.max(x), index)
+
+
+def pick(a, index, i):
+    """a[i] for a vector ``a`` whose components share ``index``'s shape (masked sum)."""
+    return tuple(jnp.sum(jnp.where(index == i, x, 0.0)) for x in a)
+
+
+def _row_of(a, index, i):
+    """Row i (index along axis 0) of each component of ``a`` ([n, k] arrays), as [k] arrays."""
+    return tuple(jnp.sum(jnp.where(index[:, None] == i, x, 0.0), axis=0) for x in a)
+
+
+def _roll1(a):
+    """jnp.roll(a, 1) of [4] components, by a permutation (out[i] = a[i - 1])."""
+    i = jnp.arange(4)
+    perm = (i[:, None] - 1) % 4 == i[None, :]
+    return tuple(jnp.sum(jnp.where(perm, x[None, :], 0.0), axis=1) for x in a)
+
+
+def _segment_plane(a, b, p0, n):  # _closest_segment_point_plane, broadcast
+    d = dot(p0, n)
+    denom = dot(n, sub(b, a))
+    t = (d - dot(n, a)) / jnp.where(denom == 0.0, denom + 1e-6, denom)
+    t = jnp.clip(t, 0, 1)
+    return add(a, scale(sub(b, a), t))
+
+
+def _clip_edges(p0, p1, plane_pts, plane_normals):
+    """_clip_edge_to_planes for 4 edges (p0, p1: [4] components) against 4 planes: the clipped ends [4] each and
+    the edges' mask [4]."""
+    e = lambda v: tuple(x[:, None] for x in v)  # noqa: E731  edges along axis 0
+    k = lambda v: tuple(x[None, :] for x in v)  # noqa: E731  planes along axis 1
+    pp, pn = k(plane_pts), k(plane_normals)
+    p0e, p1e = e(p0), e(p1)
+    p0_front = dot(sub(p0e, pp), pn) > 1e-6
+    p1_front = dot(sub(p1e, pp), pn) > 1e-6
+    cand = _segment_plane(p0e, p1e, pp, pn)
+    plane = jnp.arange(4)[None, :]
+
+    def clip_end(q0, q1, front):
+        new = where(front, cand, tuple(jnp.broadcast_to(x, front.shape) for x in q0))
+        dists = dot(sub(new, q0), sub(q1, q0))
+        best = jnp.min(jnp.where(dists == jnp.max(dists, axis=1, keepdims=True), plane, 1 << 20), axis=1)
+        return tuple(jnp.sum(jnp.where(plane == best[:, None], x, 0.0), axis=1) for x in new)
+
+    n0, n1 = clip_end(p0e, p1e, p0_front), clip_end(p1e, p0e, p1_front)
+    mask = jnp.max(jnp.where(p0_front & p1_front, 1, 0), axis=1) == 0
+    n0, n1 = where(mask, n0, p0), where(mask, n1, p1)
+    mask = jnp.where(dot(sub(p0, p1), sub(n0, n1)) < 0, False, mask)
+    return n0, n1, mask
+
+
+def _manifold(poly, mask, norm, flat):
+    """_manifold_points over the clipped points ([2, 4, 2] components, ``flat`` their MJX order)."""
+    zero = 0.0 * poly[0]
+    dist_mask = jnp.where(mask, zero, zero - 1e6)
+    a_idx = argmax(dist_mask, flat)
+    a = pick(poly, flat, a_idx)
+    ap = sub(a, poly)
+    b_idx = argmax(dot(ap, ap) + dist_mask, flat)
+    b = pick(poly, flat, b_idx)
+    ab = cross(norm, sub(a, b))
+    c_idx = argmax(jnp.abs(dot(ap, ab)) + dist_mask, flat)
+    c = pick(poly, flat, c_idx)
+    ac, bc = cross(norm, sub(a, c)), cross(norm, sub(b, c))
+    bp = sub(b, poly)
+    d_idx = argmax(jnp.abs(dot(bp, bc)) + dist_mask + jnp.abs(dot(ap, ac)) + dist_mask, flat) % 16
+    return a_idx, b_idx, c_idx, d_idx
+
+
+def _manifold_contacts(ref, inc, ref_n, inc_n, sep):
+    """_create_contact_manifold: ref and inc are [4] components (the faces' vertices)."""
+    # clip the incident face's edges against the reference face's side planes
+    c0, c1 = _roll1(ref), ref
+    c_normals = cross(sub(c1, c0), tuple(jnp.broadcast_to(x, (4,)) for x in ref_n))
+    s0, s1 = _roll1(inc), inc
+    s_normals = cross(sub(s1, s0), tuple(jnp.broadcast_to(x, (4,)) for x in inc_n))
+    a0, a1, amask = _clip_edges(s0, s1, c0, c_normals)
+    # the reference face's edges, projected onto the incident face's plane, against its side planes
+    d = dot(pick(inc, jnp.arange(4), 0), inc_n)
+    denom = dot(ref_n, inc_n)
+
+    def project(p):
+        t = (d - dot(p, inc_n)) / jnp.where(denom == 0.0, denom + 1e-6, denom)
+        return add(p, scale(ref_n, t))
+
+    b0, b1, bmask = _clip_edges(project(c0), project(c1), s0, s_normals)
+    # the 16 points in (set, edge, end) layout
+    s_idx = jnp.arange(2)[:, None, None]
+    end = jnp.arange(2)[None, None, :]
+    edge = jnp.arange(4)[None, :, None]
+
+    def layout(x0, x1, y0, y1):
+        xs = jnp.where(end == 0, x0[None, :, None], x1[None, :, None])
+        ys = jnp.where(end == 0, y0[None, :, None], y1[None, :, None])
+        return jnp.where(s_idx == 0, xs, ys)
+
+    incident = tuple(layout(*q) for q in zip(a0, a1, b0, b1, strict=True))
+    mask = jnp.where(s_idx == 0, amask[None, :, None], bmask[None, :, None]) & (end >= 0)
+    flat = s_idx * 8 + edge * 2 + end
+    nn = normalize(ref_n)
+    r0 = pick(ref, jnp.arange(4), 0)
+    dist0 = dot(sub(incident, r0), nn)
+    poly_ref = sub(incident, scale(nn, dist0))
+    mask = mask & (dot(sub(incident, r0), scale(ref_n, -1.0)) > 1e-6)
+    best = _manifold(poly_ref, mask, ref_n, flat)
+    pts = [pick(poly_ref, flat, i) for i in best]
+    pmask = [jnp.max(jnp.where((flat == i) & mask, 1, 0)) > 0 for i in best]
+    pen = [dot(sub(pick(incident, flat, i), p), scale(ref_n, -1.0)) for i, p in zip(best, pts, strict=True)]
+    dist = [jnp.where(m, -q, 1.0) for m, q in zip(pmask, pen, strict=True)]
+    normal = scale(sep, -1.0)
+    return dist, pts, normal
+
+
+def box_box_soa(pos1, mat1, size1, pos2, mat2, size2):
+    """box_box's (dist [4], pos as (x, y, z) [4] arrays, frame rows as tuples of scalars)."""
+    m1 = mat1 if isinstance(mat1, tuple) else tuple(_v(mat1[i]) for i in range(3))  # rows
+    m2 = mat2 if isinstance(mat2, tuple) else tuple(_v(mat2[i]) for i in range(3))
+    m2t = tuple(tuple(m2[j][i] for j in range(3)) for i in range(3))
+    rel = tuple(tuple(dot(m2t[i], tuple(m1[k][j] for k in range(3))) for j in range(3)) for i in range(3))  # m2^T m1
+    pos1, pos2, size1, size2 = (x if isinstance(x, tuple) else _v(x) for x in (pos1, pos2, size1, size2))
+    t = matvec(m2t, sub(pos1, pos2))
+    s1, s2 = size1, size2
+    # box 1's vertices and faces in box 2's frame, box 2's in its own
+    vi = jnp.arange(8)
+    vert = tuple(((vi >> (2 - c)) & 1).astype(t[0].dtype) * 2 - 1 for c in range(3))
+    va = add(t, matvec(rel, tuple(vert[i] * s1[i] for i in range(3))))
+    vb = tuple(vert[i] * s2[i] for i in range(3))
+    fi, ki = jnp.arange(NF)[:, None], jnp.arange(4)[None, :]
+    face_vi = jnp.zeros((NF, 4), jnp.int32)
+    for f in range(6):
+        for k in range(4):
+            face_vi = jnp.where((fi == f) & (ki == k), int(_FACE[f, k]), face_vi)
+    face_unit = tuple(((face_vi >> (2 - c)) & 1).astype(t[0].dtype) * 2 - 1 for c in range(3))  # [8, 4]
+    fa = add(tuple(x[..., None, None] for x in t), matvec(rel, tuple(face_unit[i] * s1[i] for i in range(3))))
+    fb = tuple(face_unit[i] * s2[i] for i in range(3))
+    f8 = jnp.arange(NF)
+    normal_unit = tuple(sum(jnp.where(f8 == f, float(_NORMAL[f, c]), 0.0) for f in range(6)) for c in range(3))
+    na = matvec(rel, normal_unit)
+    nb = normal_unit
+    # separating axes: 6 + 6 face normals, then the 9 edge-pair crosses (a tiled, b repeated), padded to 32
+    ax_i = jnp.arange(NA)
+    ea = tuple(tuple(rel[r][c] for r in range(3)) for c in range(3))  # box 1's axes in box 2's frame
+    eb = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    axes = [jnp.zeros((NA,), t[0].dtype) for _ in range(3)]
+    degenerate = ax_i >= 21
+    for f in range(6):
+        for c in range(3):
+            axes[c] = jnp.where(ax_i == f, jnp.sum(jnp.where(jnp.arange(NF) == f, na[c], 0.0)), axes[c])
+            axes[c] = jnp.where(ax_i == 6 + f, float(_NORMAL[f, c]), axes[c])
+    for q in range(9):
+        cr = cross(ea[q % 3], eb[q // 3])
+        deg = dot(cr, cr) < 1e-6
+        cr = normalize(cr)
+        for c in range(3):
+            axes[c] = jnp.where(ax_i == 12 + q, cr[c], axes[c])
+        degenerate = jnp.where(ax_i == 12 + q, deg, degenerate)
+    axes = tuple(axes)
+    pa = dot(tuple(x[:, None] for x in axes), tuple(x[None, :] for x in va))  # [32, 8]
+    pb = dot(tuple(x[:, None] for x in axes), tuple(x[None, :] for x in vb))
+    dist1 = jnp.max(pa, axis=1) - jnp.min(pb, axis=1)
+    dist2 = jnp.max(pb, axis=1) - jnp.min(pa, axis=1)
+    sign = jnp.where(dist1 > dist2, 0.0 * dist1 - 1.0, 0.0 * dist1 + 1.0)
+    support = jnp.where(degenerate, 1e6, jnp.minimum(dist1, dist2))
+    support = jnp.where(ax_i >= 21, BIG, support)
+    best_face_idx = argmin(jnp.where(ax_i < 12, support, BIG), ax_i)
+    best_face_axis = pick(axes, ax_i, best_face_idx)
+    best_idx = argmin(support, ax_i)
+    best_sign = jnp.sum(jnp.where(ax_i == best_idx, sign, 0.0))
+    best_axis = pick(axes, ax_i, best_idx)
+    is_edge = (best_idx >= 12) & (jnp.abs(dot(best_face_axis, best_axis)) < 0.99)
+    f_i = jnp.arange(NF)
+    real = f_i < 6
+    da, db = dot(na, best_axis), dot(nb, best_axis)
+    a_max = argmax(jnp.where(real, da, -BIG), f_i)
+    b_max = argmax(jnp.where(real, db, -BIG), f_i)
+    a_min = argmin(jnp.where(real, da, BIG), f_i)
+    b_min = argmin(jnp.where(real, db, BIG), f_i)
+    pos_sign = best_sign > 0
+    ref = where(pos_sign, _row_of(fa, f_i, a_max), _row_of(fb, f_i, b_max))
+    ref_n = where(pos_sign, pick(na, f_i, a_max), pick(nb, f_i, b_max))
+    inc = where(pos_sign, _row_of(fb, f_i, b_min), _row_of(fa, f_i, a_min))
+    inc_n = where(pos_sign, pick(nb, f_i, b_min), pick(na, f_i, a_min))
+    dist, pts, normal = _manifold_contacts(ref, inc, ref_n, inc_n, scale(best_axis, -best_sign))
+    # edge contacts keep the deepest clipped point alone
+    i4 = jnp.arange(4)
+    vec4 = lambda xs: sum(jnp.where(i4 == i, x, 0.0) for i, x in enumerate(xs))  # noqa: E731
+    dvec = vec4(dist)
+    pvec = tuple(vec4([p[c] for p in pts]) for c in range(3))
+    idx = argmin(dvec, i4)
+    deep = pick(pvec, i4, idx)
+    dvec = jnp.where(is_edge, jnp.where(i4 == 0, jnp.min(dvec), 1.0), dvec)
+    pvec = where(is_edge, tuple(jnp.broadcast_to(x, (4,)) for x in deep), pvec)
+    # back to the world frame
+    world = add(tuple(jnp.broadcast_to(x, (4,)) for x in pos2), matvec(m2, pvec))
+    n = matvec(m2, normal)
+    dvec = jnp.where(jnp.isinf(dvec), jnp.finfo(dvec.dtype).max, dvec)
+    return dvec, world, frame_rows(n)
+
+
+def box_box(pos1, mat1, size1, pos2, mat2, size2):
+    """(dist [4], pos [4, 3], frame [4, 3, 3]) as MJX's box_box for two boxes (pos [3], mat [3, 3], half sizes)."""
+    dist, world, rows = box_box_soa(pos1, mat1, size1, pos2, mat2, size2)
+    pos = jnp.stack(world, axis=-1)
+    frame = jnp.stack([jnp.stack(r) for r in rows])
+    return dist, pos, jnp.broadcast_to(frame, (4, 3, 3))
+
+
+def frame_rows(a):
+    """math.make_frame's rows (a, b, c) as tuples of scalars."""
+    a = normalize(a)
+    use_y = (-0.5 < a[1]) & (a[1] < 0.5)
+    zero = 0.0 * a[0]  # a select of two constants lowers to a boolean in Triton: select against a value
+    b = (zero, jnp.where(use_y, zero + 1.0, zero), jnp.where(use_y, zero, zero + 1.0))
+    b = sub(b, scale(a, dot(a, b)))
+    nonzero = (a[0] != 0) | (a[1] != 0) | (a[2] != 0)
+    b = tuple(jnp.where(nonzero, x, 0.0) for x in normalize(b))
+    return a, b, cross(a, b)
+
+
+def _pack(pos1, mat1, size1, pos2, mat2, size2):
+    flat = jnp.concatenate([pos1, mat1.reshape(9), size1, pos2, mat2.reshape(9), size2])
+    return jnp.pad(flat, (0, 32 - flat.shape[0]))
+
+
+def kernel_box_box(pos1, mat1, size1, pos2, mat2, size2, interpret=False, num_warps=None):
+    """box_box for one pair as one Pallas kernel (vmap: the pairs and envs are its grid), through Triton."""
+    from jax.experimental import pallas as pl
+    from jax.experimental.pallas import triton as pl_triton
+
+    def kernel(in_ref, out_ref):
+        x = in_ref[...]
+        i32 = jnp.arange(32)
+        v = [jnp.sum(jnp.where(i32 == k, x, 0.0)) for k in range(30)]
+        p1, m1, s1 = tuple(v[0:3]), (tuple(v[3:6]), tuple(v[6:9]), tuple(v[9:12])), tuple(v[12:15])
+        p2, m2, s2 = tuple(v[15:18]), (tuple(v[18:21]), tuple(v[21:24]), tuple(v[24:27])), tuple(v[27:30])
+        dist, world, rows = box_box_soa(p1, m1, s1, p2, m2, s2)
+        i4 = jnp.arange(4)
+        out = jnp.zeros((32,), x.dtype)
+        for blk, arr in enumerate((dist, *world)):
+            for i in range(4):
+                out = jnp.where(i32 == blk * 4 + i, jnp.sum(jnp.where(i4 == i, arr, 0.0)), out)
+        for r in range(3):
+            for c in range(3):
+                out = jnp.where(i32 == 16 + 3 * r + c, rows[r][c], out)
+        out_ref[...] = out
+
+    packed = _pack(pos1, mat1, size1, pos2, mat2, size2)
+    out = pl.pallas_call(
+        kernel,
+        out_shape=jax.ShapeDtypeStruct((32,), packed.dtype),
+        interpret=interpret,
+        compiler_params=pl_triton.CompilerParams(num_warps=num_warps),
+    )(packed)
+    dist = out[0:4]
+    pos = jnp.stack([out[4:8], out[8:12], out[12:16]], axis=-1)
+    frame = out[16:25].reshape(3, 3)
+    return dist, pos, jnp.broadcast_to(frame, (4, 3, 3))
+
+
+def _collide(m, d, key, geom, kernel: bool):
+    """The collision driver's function for the box-box group: every pair's four contacts, pairs in order."""
+    g1, g2 = geom.T
+    fn = kernel_box_box if kernel else box_box
+    dist, pos, frame = jax.vmap(fn)(d.geom_xpos[g1], d.geom_xmat[g1], m.geom_size[g1], d.geom_xpos[g2],
+                                    d.geom_xmat[g2], m.geom_size[g2])  # fmt: skip
+    return dist.reshape(-1), pos.reshape(-1, 3), frame.reshape(-1, 3, 3)
+
+
+def chosen(choice: str, backend: str) -> bool:
+    """Whether a task's ``collision`` choice collides boxes here: ``fused`` always, ``gpu-fused`` on a GPU only."""
+    return choice == "fused" or (choice == "gpu-fused" and backend == "gpu")
+
+
+@contextlib.contextmanager
+def fused_in_mjx(enabled: bool = True, kernel: bool = False):
+    """Within the block, MJX's collision driver collides box pairs through ``box_box`` (as a Pallas kernel if
+    ``kernel``). The driver looks its functions up when its code runs, which under ``jit`` is trace time only."""
+    if not enabled:
+        yield
+        return
+    from mujoco.mjx._src import collision_driver
+    from mujoco.mjx._src.types import GeomType
+
+    key = (GeomType.BOX, GeomType.BOX)
+
+    def collide(m, d, group, geom):
+        return _collide(m, d, group, geom, kernel)
+
+    collide.ncon = 4
+    with TRACE_LOCK:
+        saved = collision_driver._COLLISION_FUNC[key]
+        collision_driver._COLLISION_FUNC[key] = collide
+        try:
+            yield
+        finally:
+            collision_driver._COLLISION_FUNC[key] = saved

@@ -1,0 +1,117 @@
+"""MJX's box-box contacts as one program per pair: MJX's contacts (as a set, up to MJX's float ties), its Pallas
+kernel the same function lowered as one Triton call, and a scripted Push path as MJX's."""
+
+from __future__ import annotations
+
+import functools
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from mujoco.mjx._src import collision_convex, collision_driver, math, mesh
+from mujoco.mjx._src.collision_types import GeomInfo
+
+import envs
+from envs import fused_collision
+from envs.fetch.scripted import CONTROLLERS
+
+
+def _rotation(q):
+    w, x, y, z = q / jnp.linalg.norm(q)
+    return jnp.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                      [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                      [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])  # fmt: skip
+
+
+def _pairs(n: int, seed: int = 0):
+    """Box pairs near contact: tilted a little, face to face, and at random orientations."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    for i in range(n):
+        q = [np.array([1.0, *rng.normal(0, 0.02, 3)]) for _ in range(2)] if i % 3 == 0 else (
+            [np.array([1.0, 0, 0, 0]), np.array([1.0, 0, 0, rng.normal(0, 0.3)])] if i % 3 == 1
+            else [rng.normal(size=4) for _ in range(2)])  # fmt: skip
+        p2 = rng.normal(0, 0.1, 3)
+        direction = rng.normal(size=3)
+        p1 = p2 + direction / np.linalg.norm(direction) * rng.uniform(0.0, 0.06)
+        rows.append((p1, _rotation(jnp.asarray(q[0])), rng.uniform(0.01, 0.04, 3),
+                     p2, _rotation(jnp.asarray(q[1])), rng.uniform(0.01, 0.04, 3)))  # fmt: skip
+    return [jnp.asarray(np.stack([np.asarray(r[k]) for r in rows]), jnp.float32) for k in range(6)]
+
+
+def _mjx(p1, m1, s1, p2, m2, s2):
+    infos = [mesh.box(GeomInfo(p1, m1, s1)), mesh.box(GeomInfo(p2, m2, s2))]
+    axes = [jax.tree_util.tree_map(lambda x: None, i).replace(pos=0, mat=0, size=0, face=0, vert=0) for i in infos]
+
+    def one(b1, b2):
+        dist, pos, n = collision_convex._box_box(b1, b2)
+        return dist, pos, jax.vmap(math.make_frame)(n)
+
+    return jax.vmap(one, in_axes=axes)(*infos)
+
+
+def _contacts(dist, pos, i):
+    """Pair i's contacts in contact, as a set of rounded (x, y, z, dist)."""
+    rows = np.concatenate([np.asarray(pos[i]), np.asarray(dist[i])[:, None]], axis=1).round(5)
+    return {tuple(r) for r in rows if r[3] < 0}
+
+
+def test_box_box_makes_mjxs_contacts():
+    args = _pairs(90)
+    want = jax.jit(_mjx)(*args)
+    got = jax.jit(jax.vmap(fused_collision.box_box))(*args)
+    np.testing.assert_allclose(got[2], want[2], atol=1e-5)  # the normal's frame: the same separating axis
+    touching = np.asarray(want[0] < 0).any(axis=1)
+    assert touching.sum() > 50
+    same = [_contacts(*got[:2], i) == _contacts(*want[:2], i) for i in range(len(touching))]
+    assert sum(same) >= 0.95 * len(same), [i for i, ok in enumerate(same) if not ok]
+
+
+def test_kernel_is_the_function_and_lowers_as_one_triton_call():
+    args = _pairs(12, seed=1)
+    plain = jax.jit(jax.vmap(fused_collision.box_box))(*args)
+    kernel = jax.jit(jax.vmap(functools.partial(fused_collision.kernel_box_box, interpret=True)))(*args)
+    for i in range(12):
+        assert _contacts(*kernel[:2], i) == _contacts(*plain[:2], i)
+    lowered = jax.jit(jax.vmap(fused_collision.kernel_box_box)).trace(*args).lower(lowering_platforms=("cuda",))
+    assert lowered.as_text().count("xla.gpu.triton") == 1
+
+
+def _scripted_path(**options) -> np.ndarray:
+    env = envs.make("push", solver_loops="loops", **options)
+    state = jax.jit(jax.vmap(env.reset))(jax.random.split(jax.random.PRNGKey(0), 4))
+    act = jax.vmap(CONTROLLERS["push"])
+
+    def step(s, _):
+        s = jax.vmap(env.step)(s, act(s.obs, s.desired_goal))
+        return s, s.physics.qpos
+
+    return np.asarray(jax.jit(lambda s: jax.lax.scan(step, s, None, length=8)[1])(state))
+
+
+def test_push_path_follows_mjxs():
+    # the finger block meets the cube from the seventh step on: without its contacts the path parts there by 0.017;
+    # after the eighth, contact amplifies float rounding (MJX's own library Cholesky parts by 4e-3 a step later)
+    base, fused = _scripted_path(), _scripted_path(collision="fused")
+    assert np.isfinite(fused).all()
+    np.testing.assert_allclose(fused, base, atol=1e-5)
+
+
+def test_driver_keeps_mjxs_function_outside_the_block():
+    key = next(k for k in collision_driver._COLLISION_FUNC if len(k) == 2 and k[0] == k[1] == 6)
+    before = collision_driver._COLLISION_FUNC[key]
+    with fused_collision.fused_in_mjx():
+        assert collision_driver._COLLISION_FUNC[key] is not before
+    assert collision_driver._COLLISION_FUNC[key] is before
+    assert [fused_collision.chosen("gpu-fused", b) for b in ("gpu", "cpu")] == [True, False]
+
+
+def test_push_collides_boxes_in_a_kernel_on_a_gpu_when_asked(monkeypatch):
+    env = envs.make("push", substeps=1, collision="gpu-fused")
+    state = jax.eval_shape(jax.vmap(env.reset), jax.random.split(jax.random.PRNGKey(0), 4))
+    actions = jax.ShapeDtypeStruct((4, 4), jnp.float32)
+    cpu = jax.jit(lambda s, a: jax.vmap(env.step)(s, a)).trace(state, actions).lower().as_text()
+    assert "triton" not in cpu
+    monkeypatch.setattr(jax, "default_backend", lambda: "gpu")
+    gpu = jax.jit(lambda s, a: jax.vmap(env.step)(s, a)).trace(state, actions).lower(lowering_platforms=("cuda",))
+    assert gpu.as_text().count("xla.gpu.triton") == 2  # the box pair's contacts and the constraint solve
