@@ -1,23 +1,26 @@
-"""MJX's box-box contacts (``mujoco.mjx._src.collision_convex.box_box``) as one program per box pair, and on a GPU
-as one Pallas kernel.
+"""MJX's box-box and plane-box contacts (``mujoco.mjx._src.collision_convex.box_box``, ``plane_convex``) as one
+program per geom pair, and on a GPU as one Pallas kernel per pair group.
 
 Why: after the constraint solve (``envs/fused_solver.py``), collision is the largest part of a Push control step on a
 GPU (about 530 small kernels of its 2,600 at 16 envs before the solve kernel; BENCHMARKS.md, "Time budget per stage"),
 and of MJX's collision for Push the box-box pair (the finger block against the cube) is 1,111 of its 1,612 traced
 equations. The arithmetic is MJX's: the separating-axis test over the 6 + 6 face normals and 9 edge crosses, the
-reference and incident faces, their clipping, the choice of four manifold points, the edge-contact rule.
+reference and incident faces, their clipping, the choice of four manifold points, the edge-contact rule; for a
+plane, the box's vertices within 1 mm of its deepest and the same choice of four.
 
 Written for what a Triton kernel holds: vectors as (x, y, z) tuples of arrays, no gathers (picks by masks), argmax
 and argmin as the first index of the extreme, no concatenation, no constant arrays (vertices and faces from iota),
 shapes padded to powers of two; the clipped points keep a (set, edge, end) layout of shape (2, 4, 2) in MJX's order.
 Where MJX's choice is a float tie (boxes face to face: two equally deep points, two equally good fourth points) the
 rounding of either implementation decides, so the contacts agree as a set, their order or a duplicated point may
-differ; under MJX's own solver variants a Push path parts in the same way (``tests/envs/test_fused_collision.py``).
+differ. A scripted Push path follows MJX's within 1e-5 through the finger's first contacts; after them contact
+amplifies rounding, as it does between MJX's own variants (``tests/envs/test_fused_collision.py``).
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
 
 import jax
 import jax.numpy as jnp
@@ -131,8 +134,8 @@ def _clip_edges(p0, p1, plane_pts, plane_normals):
     return n0, n1, mask
 
 
-def _manifold(poly, mask, norm, flat):
-    """_manifold_points over the clipped points ([2, 4, 2] components, ``flat`` their MJX order)."""
+def _manifold(poly, mask, norm, flat, count: int):
+    """_manifold_points over ``count`` points (components of any shape, ``flat`` their index in MJX's order)."""
     zero = 0.0 * poly[0]
     dist_mask = jnp.where(mask, zero, zero - 1e6)
     a_idx = argmax(dist_mask, flat)
@@ -145,7 +148,7 @@ def _manifold(poly, mask, norm, flat):
     c = pick(poly, flat, c_idx)
     ac, bc = cross(norm, sub(a, c)), cross(norm, sub(b, c))
     bp = sub(b, poly)
-    d_idx = argmax(jnp.abs(dot(bp, bc)) + dist_mask + jnp.abs(dot(ap, ac)) + dist_mask, flat) % 16
+    d_idx = argmax(jnp.abs(dot(bp, bc)) + dist_mask + jnp.abs(dot(ap, ac)) + dist_mask, flat) % count
     return a_idx, b_idx, c_idx, d_idx
 
 
@@ -184,7 +187,7 @@ def _manifold_contacts(ref, inc, ref_n, inc_n, sep):
     dist0 = dot(sub(incident, r0), nn)
     poly_ref = sub(incident, scale(nn, dist0))
     mask = mask & (dot(sub(incident, r0), scale(ref_n, -1.0)) > 1e-6)
-    best = _manifold(poly_ref, mask, ref_n, flat)
+    best = _manifold(poly_ref, mask, ref_n, flat, 16)
     pts = [pick(poly_ref, flat, i) for i in best]
     pmask = [jnp.max(jnp.where((flat == i) & mask, 1, 0)) > 0 for i in best]
     pen = [dot(sub(pick(incident, flat, i), p), scale(ref_n, -1.0)) for i, p in zip(best, pts, strict=True)]
@@ -279,12 +282,47 @@ def box_box_soa(pos1, mat1, size1, pos2, mat2, size2):
     return dvec, world, frame_rows(n)
 
 
+def plane_box_soa(plane_pos, plane_mat, box_pos, box_mat, box_size):
+    """plane_box's (dist [4], pos as (x, y, z) [4] arrays, frame rows as tuples of scalars)."""
+    rows = lambda m: m if isinstance(m, tuple) else tuple(_v(m[i]) for i in range(3))  # noqa: E731
+    vec = lambda x: x if isinstance(x, tuple) else _v(x)  # noqa: E731
+    pm, bm = rows(plane_mat), rows(box_mat)
+    plane_pos, box_pos, size = vec(plane_pos), vec(box_pos), vec(box_size)
+    bmt = tuple(tuple(bm[j][i] for j in range(3)) for i in range(3))
+    normal = (pm[0][2], pm[1][2], pm[2][2])  # the plane's z axis
+    local_pos, n = matvec(bmt, sub(plane_pos, box_pos)), matvec(bmt, normal)
+    vi = jnp.arange(8)
+    vert = tuple((((vi >> (2 - c)) & 1).astype(size[0].dtype) * 2 - 1) * size[c] for c in range(3))
+    support = dot(sub(tuple(jnp.broadcast_to(x, (8,)) for x in local_pos), vert), n)
+    mask = support > jnp.maximum(0.0, jnp.max(support) - 1e-3)  # manifold points within a 1 mm skin
+    best = _manifold(vert, mask, n, vi, 8)
+    i4 = jnp.arange(4)
+    vec4 = lambda xs: sum(jnp.where(i4 == i, x, 0.0) for i, x in enumerate(xs))  # noqa: E731
+    idx = vec4(best)
+    local = tuple(vec4([pick(vert, vi, i)[c] for i in best]) for c in range(3))
+    depth = vec4([jnp.sum(jnp.where(vi == i, support, 0.0)) for i in best])
+    earlier = sum(jnp.where((i4 > j) & (idx == best[j]), 1, 0) for j in range(4))  # a point chosen before
+    dist = jnp.where(earlier == 0, -depth, 0.0 * depth + 1.0)
+    world = add(tuple(jnp.broadcast_to(x, (4,)) for x in box_pos), matvec(bm, local))
+    world = sub(world, scale(tuple(jnp.broadcast_to(x, (4,)) for x in normal), 0.5 * dist))
+    return dist, world, frame_rows(normal)
+
+
+def _as_arrays(soa):
+    """(dist [4], pos [4, 3], frame [4, 3, 3]) from a contact function's structure-of-arrays result."""
+    dist, world, rows = soa
+    frame = jnp.stack([jnp.stack(r) for r in rows])
+    return dist, jnp.stack(world, axis=-1), jnp.broadcast_to(frame, (4, 3, 3))
+
+
 def box_box(pos1, mat1, size1, pos2, mat2, size2):
     """(dist [4], pos [4, 3], frame [4, 3, 3]) as MJX's box_box for two boxes (pos [3], mat [3, 3], half sizes)."""
-    dist, world, rows = box_box_soa(pos1, mat1, size1, pos2, mat2, size2)
-    pos = jnp.stack(world, axis=-1)
-    frame = jnp.stack([jnp.stack(r) for r in rows])
-    return dist, pos, jnp.broadcast_to(frame, (4, 3, 3))
+    return _as_arrays(box_box_soa(pos1, mat1, size1, pos2, mat2, size2))
+
+
+def plane_box(plane_pos, plane_mat, box_pos, box_mat, box_size):
+    """(dist [4], pos [4, 3], frame [4, 3, 3]) as MJX's plane_convex for a plane and a box."""
+    return _as_arrays(plane_box_soa(plane_pos, plane_mat, box_pos, box_mat, box_size))
 
 
 def frame_rows(a):
@@ -299,23 +337,29 @@ def frame_rows(a):
     return a, b, cross(a, b)
 
 
-def _pack(pos1, mat1, size1, pos2, mat2, size2):
-    flat = jnp.concatenate([pos1, mat1.reshape(9), size1, pos2, mat2.reshape(9), size2])
-    return jnp.pad(flat, (0, 32 - flat.shape[0]))
-
-
-def kernel_box_box(pos1, mat1, size1, pos2, mat2, size2, interpret=False, num_warps=None):
-    """box_box for one pair as one Pallas kernel (vmap: the pairs and envs are its grid), through Triton."""
+def _kernel(soa_fn, *args, interpret=False, num_warps=None):
+    """``soa_fn`` on one pair's arrays (vectors [3], matrices [3, 3]) as one Pallas kernel through Triton: the inputs
+    packed in one [32] vector, the outputs (4 distances, 4 points, a frame) in another; ``vmap`` makes the pairs
+    and envs its grid."""
     from jax.experimental import pallas as pl
     from jax.experimental.pallas import triton as pl_triton
+
+    shapes = [a.shape for a in args]
+    flat = jnp.concatenate([a.reshape(-1) for a in args])
+    packed = jnp.pad(flat, (0, 32 - flat.shape[0]))
 
     def kernel(in_ref, out_ref):
         x = in_ref[...]
         i32 = jnp.arange(32)
-        v = [jnp.sum(jnp.where(i32 == k, x, 0.0)) for k in range(30)]
-        p1, m1, s1 = tuple(v[0:3]), (tuple(v[3:6]), tuple(v[6:9]), tuple(v[9:12])), tuple(v[12:15])
-        p2, m2, s2 = tuple(v[15:18]), (tuple(v[18:21]), tuple(v[21:24]), tuple(v[24:27])), tuple(v[27:30])
-        dist, world, rows = box_box_soa(p1, m1, s1, p2, m2, s2)
+        v = [jnp.sum(jnp.where(i32 == k, x, 0.0)) for k in range(flat.shape[0])]
+        values, at = [], 0
+        for shape in shapes:
+            if shape == (3,):
+                values.append(tuple(v[at : at + 3]))
+            else:
+                values.append(tuple(tuple(v[at + 3 * r : at + 3 * r + 3]) for r in range(3)))
+            at += 3 if shape == (3,) else 9
+        dist, world, rows = soa_fn(*values)
         i4 = jnp.arange(4)
         out = jnp.zeros((32,), x.dtype)
         for blk, arr in enumerate((dist, *world)):
@@ -326,7 +370,6 @@ def kernel_box_box(pos1, mat1, size1, pos2, mat2, size2, interpret=False, num_wa
                 out = jnp.where(i32 == 16 + 3 * r + c, rows[r][c], out)
         out_ref[...] = out
 
-    packed = _pack(pos1, mat1, size1, pos2, mat2, size2)
     out = pl.pallas_call(
         kernel,
         out_shape=jax.ShapeDtypeStruct((32,), packed.dtype),
@@ -339,12 +382,32 @@ def kernel_box_box(pos1, mat1, size1, pos2, mat2, size2, interpret=False, num_wa
     return dist, pos, jnp.broadcast_to(frame, (4, 3, 3))
 
 
-def _collide(m, d, key, geom, kernel: bool):
+def kernel_box_box(pos1, mat1, size1, pos2, mat2, size2, interpret=False, num_warps=None):
+    """box_box for one pair as one Pallas kernel (vmap: the pairs and envs are its grid), through Triton."""
+    return _kernel(box_box_soa, pos1, mat1, size1, pos2, mat2, size2, interpret=interpret, num_warps=num_warps)
+
+
+def kernel_plane_box(plane_pos, plane_mat, box_pos, box_mat, box_size, interpret=False, num_warps=None):
+    """plane_box for one pair as one Pallas kernel, through Triton."""
+    return _kernel(plane_box_soa, plane_pos, plane_mat, box_pos, box_mat, box_size, interpret=interpret,
+                   num_warps=num_warps)  # fmt: skip
+
+
+def _box_box_group(m, d, key, geom, kernel: bool):
     """The collision driver's function for the box-box group: every pair's four contacts, pairs in order."""
     g1, g2 = geom.T
     fn = kernel_box_box if kernel else box_box
     dist, pos, frame = jax.vmap(fn)(d.geom_xpos[g1], d.geom_xmat[g1], m.geom_size[g1], d.geom_xpos[g2],
                                     d.geom_xmat[g2], m.geom_size[g2])  # fmt: skip
+    return dist.reshape(-1), pos.reshape(-1, 3), frame.reshape(-1, 3, 3)
+
+
+def _plane_box_group(m, d, key, geom, kernel: bool):
+    """The collision driver's function for the plane-box group."""
+    g1, g2 = geom.T
+    fn = kernel_plane_box if kernel else plane_box
+    dist, pos, frame = jax.vmap(fn)(d.geom_xpos[g1], d.geom_xmat[g1], d.geom_xpos[g2], d.geom_xmat[g2],
+                                    m.geom_size[g2])  # fmt: skip
     return dist.reshape(-1), pos.reshape(-1, 3), frame.reshape(-1, 3, 3)
 
 
@@ -355,24 +418,23 @@ def chosen(choice: str, backend: str) -> bool:
 
 @contextlib.contextmanager
 def fused_in_mjx(enabled: bool = True, kernel: bool = False):
-    """Within the block, MJX's collision driver collides box pairs through ``box_box`` (as a Pallas kernel if
-    ``kernel``). The driver looks its functions up when its code runs, which under ``jit`` is trace time only."""
+    """Within the block, MJX's collision driver collides planes with boxes and boxes with boxes through
+    ``plane_box`` and ``box_box`` (as Pallas kernels if ``kernel``). The driver looks its functions up when its code
+    runs, which under ``jit`` is trace time only."""
     if not enabled:
         yield
         return
     from mujoco.mjx._src import collision_driver
     from mujoco.mjx._src.types import GeomType
 
-    key = (GeomType.BOX, GeomType.BOX)
-
-    def collide(m, d, group, geom):
-        return _collide(m, d, group, geom, kernel)
-
-    collide.ncon = 4
+    groups = {(GeomType.PLANE, GeomType.BOX): _plane_box_group, (GeomType.BOX, GeomType.BOX): _box_box_group}
+    table = collision_driver._COLLISION_FUNC
     with TRACE_LOCK:
-        saved = collision_driver._COLLISION_FUNC[key]
-        collision_driver._COLLISION_FUNC[key] = collide
+        saved = {key: table[key] for key in groups}
+        for key, group in groups.items():
+            table[key] = functools.partial(group, kernel=kernel)
+            table[key].ncon = 4
         try:
             yield
         finally:
-            collision_driver._COLLISION_FUNC[key] = saved
+            table.update(saved)

@@ -1,5 +1,6 @@
-"""MJX's box-box contacts as one program per pair: MJX's contacts (as a set, up to MJX's float ties), its Pallas
-kernel the same function lowered as one Triton call, and a scripted Push path as MJX's."""
+"""MJX's plane-box and box-box contacts as one program per pair: MJX's contacts (as a set, up to MJX's float ties)
+on random box pairs and on Push's states, the Pallas kernels the same functions lowered as one Triton call each,
+and a scripted Push path as MJX's."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import functools
 import jax
 import jax.numpy as jnp
 import numpy as np
+from mujoco import mjx
 from mujoco.mjx._src import collision_convex, collision_driver, math, mesh
 from mujoco.mjx._src.collision_types import GeomInfo
 
@@ -67,7 +69,7 @@ def test_box_box_makes_mjxs_contacts():
     assert sum(same) >= 0.95 * len(same), [i for i, ok in enumerate(same) if not ok]
 
 
-def test_kernel_is_the_function_and_lowers_as_one_triton_call():
+def test_kernels_are_the_functions_and_lower_as_one_triton_call_each():
     args = _pairs(12, seed=1)
     plain = jax.jit(jax.vmap(fused_collision.box_box))(*args)
     kernel = jax.jit(jax.vmap(functools.partial(fused_collision.kernel_box_box, interpret=True)))(*args)
@@ -75,6 +77,39 @@ def test_kernel_is_the_function_and_lowers_as_one_triton_call():
         assert _contacts(*kernel[:2], i) == _contacts(*plain[:2], i)
     lowered = jax.jit(jax.vmap(fused_collision.kernel_box_box)).trace(*args).lower(lowering_platforms=("cuda",))
     assert lowered.as_text().count("xla.gpu.triton") == 1
+    plane = (args[3], args[4], *args[:3])  # the second box's frame as a plane, the first box on it
+    plain = jax.jit(jax.vmap(fused_collision.plane_box))(*plane)
+    kernel = jax.jit(jax.vmap(functools.partial(fused_collision.kernel_plane_box, interpret=True)))(*plane)
+    assert int((np.asarray(plain[0]) < 0).sum()) > 0
+    for i in range(12):
+        assert _contacts(*kernel[:2], i) == _contacts(*plain[:2], i)
+    lowered = jax.jit(jax.vmap(fused_collision.kernel_plane_box)).trace(*plane).lower(lowering_platforms=("cuda",))
+    assert lowered.as_text().count("xla.gpu.triton") == 1
+
+
+def test_push_states_get_mjxs_contacts():
+    env = envs.make("push", solver_loops="loops")
+    state = jax.jit(jax.vmap(env.reset))(jax.random.split(jax.random.PRNGKey(0), 8))
+    act, step = jax.jit(jax.vmap(CONTROLLERS["push"])), jax.jit(jax.vmap(env.step))
+    names = list(state.physics.__dataclass_fields__)
+
+    def contacts(physics, fused: bool):
+        data = mjx.make_data(env.mjx_model).replace(**{n: getattr(physics, n) for n in names})
+        with fused_collision.fused_in_mjx(fused):
+            c = mjx.forward(env.mjx_model, data)._impl.contact
+        return c.dist, c.pos, c.frame
+
+    mjxs, ours = (jax.jit(jax.vmap(functools.partial(contacts, fused=f))) for f in (False, True))
+    touching = 0
+    for k in range(8):  # the finger block meets the cube from the seventh step on
+        state = step(state, act(state.obs, state.desired_goal))
+        if k in (3, 7):
+            want, got = mjxs(state.physics), ours(state.physics)
+            np.testing.assert_allclose(got[2], want[2], atol=1e-5)
+            for e in range(8):
+                assert _contacts(*got[:2], e) == _contacts(*want[:2], e)
+            touching += int((np.asarray(want[0]) < 0).sum())
+    assert touching > 50
 
 
 def _scripted_path(**options) -> np.ndarray:
@@ -98,11 +133,11 @@ def test_push_path_follows_mjxs():
 
 
 def test_driver_keeps_mjxs_function_outside_the_block():
-    key = next(k for k in collision_driver._COLLISION_FUNC if len(k) == 2 and k[0] == k[1] == 6)
-    before = collision_driver._COLLISION_FUNC[key]
+    before = dict(collision_driver._COLLISION_FUNC)
     with fused_collision.fused_in_mjx():
-        assert collision_driver._COLLISION_FUNC[key] is not before
-    assert collision_driver._COLLISION_FUNC[key] is before
+        swapped = {k for k, f in collision_driver._COLLISION_FUNC.items() if f is not before[k]}
+        assert swapped == {(0, 6), (6, 6)}  # plane-box and box-box
+    assert collision_driver._COLLISION_FUNC == before
     assert [fused_collision.chosen("gpu-fused", b) for b in ("gpu", "cpu")] == [True, False]
 
 
@@ -114,4 +149,4 @@ def test_push_collides_boxes_in_a_kernel_on_a_gpu_when_asked(monkeypatch):
     assert "triton" not in cpu
     monkeypatch.setattr(jax, "default_backend", lambda: "gpu")
     gpu = jax.jit(lambda s, a: jax.vmap(env.step)(s, a)).trace(state, actions).lower(lowering_platforms=("cuda",))
-    assert gpu.as_text().count("xla.gpu.triton") == 2  # the box pair's contacts and the constraint solve
+    assert gpu.as_text().count("xla.gpu.triton") == 3  # plane-box and box-box contacts, the constraint solve
