@@ -1,13 +1,15 @@
-"""Whether a task's solver choices (``solver_loops``) keep its physics' path, and what each costs a control step.
+"""Whether a task's solver choices (``solver_loops``, or any task options: ``--variants``) keep its physics' path,
+and what each costs a control step.
 
-Runs the same random actions from the same starts under each choice (a jitted ``lax.scan`` of ``--steps``
-batched steps), then reports each choice's compile time, its median ms per control step over ``--repeats``
-timed calls after the first (``block_until_ready``), and its qpos difference from the first choice's after the
+Runs the same random actions from the same starts under each variant (a jitted ``lax.scan`` of ``--steps``
+batched steps), then reports each variant's compile time, its median ms per control step over ``--repeats``
+timed calls after the first (``block_until_ready``), and its qpos difference from the first variant's after the
 first, the tenth and the last step: the largest over the envs, and the median env's. Contacts amplify
-float rounding, so a few envs part after some steps whichever choice is compared; the median env shows
+float rounding, so a few envs part after some steps whichever variant is compared; the median env shows
 whether the arithmetic is the same.
 
     python experiments/solver_paths.py --task push --batch 64 --steps 50 --choices gpu-search unrolled fused
+    python experiments/solver_paths.py --task push --variants "" collision=gpu-fused   # the task's default first
     python experiments/solver_paths.py --batch 4 --steps 5 --repeats 1    # CPU smoke test
 """
 
@@ -31,8 +33,8 @@ with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on i
     import envs
 
 
-def run(task: str, choice: str, batch: int, steps: int, repeats: int) -> tuple[np.ndarray, dict]:
-    env = envs.make(task, solver_loops=choice)
+def run(task: str, options: dict, batch: int, steps: int, repeats: int) -> tuple[np.ndarray, dict]:
+    env = envs.make(task, **options)
     state = jax.jit(lambda k: jax.vmap(env.reset)(jax.random.split(k, batch)))(jax.random.PRNGKey(0))
     actions = jax.random.uniform(jax.random.PRNGKey(1), (steps, batch, env.action_size), minval=-1, maxval=1)
 
@@ -56,6 +58,9 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--task", default="push")
     p.add_argument("--choices", nargs="+", default=["gpu-search", "fused"], help="solver_loops values, first the base")
+    p.add_argument("--variants", nargs="+", default=None,
+                   help="task options per variant as KEY=VALUE[,KEY=VALUE] ('' for the defaults), first the base; "
+                        "replaces --choices")  # fmt: skip
     p.add_argument("--batch", type=int, default=64)
     p.add_argument("--steps", type=int, default=50)
     p.add_argument("--repeats", type=int, default=5)
@@ -63,9 +68,11 @@ def main() -> None:
     a = p.parse_args()
     print(f"device {jax.devices()[0].device_kind}, jax {jax.__version__}, {a.task}, {a.batch} envs, {a.steps} steps")
     rows, base = [], None
-    for choice in a.choices:
-        path, row = run(a.task, choice, a.batch, a.steps, a.repeats)
-        row = {"choice": choice, **row}
+    variants = a.variants if a.variants is not None else [f"solver_loops={c}" for c in a.choices]
+    for variant in variants:
+        options = dict(item.split("=", 1) for item in variant.split(",") if item)
+        path, row = run(a.task, options, a.batch, a.steps, a.repeats)
+        row = {"variant": variant or "default", **row}
         if base is None:
             base = path
         else:
