@@ -61,3 +61,14 @@ def with_counted_jit(learner, compiler_options=None):
 
     learner.jitted = jax.jit(counted, compiler_options=compiler_options)
     return learner
+
+
+def triton_calls_in_step(env: GoalEnv, monkeypatch) -> tuple[int, int]:
+    """How many Triton kernel calls ``env``'s batched step (4 envs) holds as traced on this CPU and as traced for,
+    and lowered for, a GPU (Pallas's Triton lowering needs no device)."""
+    state = jax.eval_shape(jax.vmap(env.reset), jax.random.split(jax.random.PRNGKey(0), 4))
+    actions = jax.ShapeDtypeStruct((4, env.action_size), jnp.float32)
+    cpu = jax.jit(lambda s, a: jax.vmap(env.step)(s, a)).trace(state, actions).lower().as_text()
+    monkeypatch.setattr(jax, "default_backend", lambda: "gpu")
+    gpu = jax.jit(lambda s, a: jax.vmap(env.step)(s, a)).trace(state, actions).lower(lowering_platforms=("cuda",))
+    return cpu.count("xla.gpu.triton"), gpu.as_text().count("xla.gpu.triton")
