@@ -37,6 +37,22 @@ def _v(a):
     return tuple(a[..., i] for i in range(3))
 
 
+def _vec(x):
+    """A vector as (x, y, z): an array [..., 3] split, or a tuple kept."""
+    return x if isinstance(x, tuple) else _v(x)
+
+
+def _rows(m):
+    """A 3 x 3 matrix as a tuple of rows: an array [3, 3] split, or a tuple kept."""
+    return m if isinstance(m, tuple) else tuple(_v(m[i]) for i in range(3))
+
+
+def _vec4(xs):
+    """Four scalars as a [4] array (no concatenation: a Triton kernel has none)."""
+    i4 = jnp.arange(4)
+    return sum(jnp.where(i4 == i, x, 0.0) for i, x in enumerate(xs))
+
+
 def dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
@@ -198,13 +214,11 @@ def _manifold_contacts(ref, inc, ref_n, inc_n, sep):
 
 def box_box_soa(pos1, mat1, size1, pos2, mat2, size2):
     """box_box's (dist [4], pos as (x, y, z) [4] arrays, frame rows as tuples of scalars)."""
-    m1 = mat1 if isinstance(mat1, tuple) else tuple(_v(mat1[i]) for i in range(3))  # rows
-    m2 = mat2 if isinstance(mat2, tuple) else tuple(_v(mat2[i]) for i in range(3))
+    m1, m2 = _rows(mat1), _rows(mat2)
     m2t = tuple(tuple(m2[j][i] for j in range(3)) for i in range(3))
     rel = tuple(tuple(dot(m2t[i], tuple(m1[k][j] for k in range(3))) for j in range(3)) for i in range(3))  # m2^T m1
-    pos1, pos2, size1, size2 = (x if isinstance(x, tuple) else _v(x) for x in (pos1, pos2, size1, size2))
+    pos1, pos2, s1, s2 = (_vec(x) for x in (pos1, pos2, size1, size2))
     t = matvec(m2t, sub(pos1, pos2))
-    s1, s2 = size1, size2
     # box 1's vertices and faces in box 2's frame, box 2's in its own
     vi = jnp.arange(8)
     vert = tuple(((vi >> (2 - c)) & 1).astype(t[0].dtype) * 2 - 1 for c in range(3))
@@ -268,9 +282,8 @@ def box_box_soa(pos1, mat1, size1, pos2, mat2, size2):
     dist, pts, normal = _manifold_contacts(ref, inc, ref_n, inc_n, scale(best_axis, -best_sign))
     # edge contacts keep the deepest clipped point alone
     i4 = jnp.arange(4)
-    vec4 = lambda xs: sum(jnp.where(i4 == i, x, 0.0) for i, x in enumerate(xs))  # noqa: E731
-    dvec = vec4(dist)
-    pvec = tuple(vec4([p[c] for p in pts]) for c in range(3))
+    dvec = _vec4(dist)
+    pvec = tuple(_vec4([p[c] for p in pts]) for c in range(3))
     idx = argmin(dvec, i4)
     deep = pick(pvec, i4, idx)
     dvec = jnp.where(is_edge, jnp.where(i4 == 0, jnp.min(dvec), 1.0), dvec)
@@ -284,10 +297,8 @@ def box_box_soa(pos1, mat1, size1, pos2, mat2, size2):
 
 def plane_box_soa(plane_pos, plane_mat, box_pos, box_mat, box_size):
     """plane_box's (dist [4], pos as (x, y, z) [4] arrays, frame rows as tuples of scalars)."""
-    rows = lambda m: m if isinstance(m, tuple) else tuple(_v(m[i]) for i in range(3))  # noqa: E731
-    vec = lambda x: x if isinstance(x, tuple) else _v(x)  # noqa: E731
-    pm, bm = rows(plane_mat), rows(box_mat)
-    plane_pos, box_pos, size = vec(plane_pos), vec(box_pos), vec(box_size)
+    pm, bm = _rows(plane_mat), _rows(box_mat)
+    plane_pos, box_pos, size = _vec(plane_pos), _vec(box_pos), _vec(box_size)
     bmt = tuple(tuple(bm[j][i] for j in range(3)) for i in range(3))
     normal = (pm[0][2], pm[1][2], pm[2][2])  # the plane's z axis
     local_pos, n = matvec(bmt, sub(plane_pos, box_pos)), matvec(bmt, normal)
@@ -297,10 +308,9 @@ def plane_box_soa(plane_pos, plane_mat, box_pos, box_mat, box_size):
     mask = support > jnp.maximum(0.0, jnp.max(support) - 1e-3)  # manifold points within a 1 mm skin
     best = _manifold(vert, mask, n, vi, 8)
     i4 = jnp.arange(4)
-    vec4 = lambda xs: sum(jnp.where(i4 == i, x, 0.0) for i, x in enumerate(xs))  # noqa: E731
-    idx = vec4(best)
-    local = tuple(vec4([pick(vert, vi, i)[c] for i in best]) for c in range(3))
-    depth = vec4([jnp.sum(jnp.where(vi == i, support, 0.0)) for i in best])
+    idx = _vec4(best)
+    local = tuple(_vec4([pick(vert, vi, i)[c] for i in best]) for c in range(3))
+    depth = _vec4([jnp.sum(jnp.where(vi == i, support, 0.0)) for i in best])
     earlier = sum(jnp.where((i4 > j) & (idx == best[j]), 1, 0) for j in range(4))  # a point chosen before
     dist = jnp.where(earlier == 0, -depth, 0.0 * depth + 1.0)
     world = add(tuple(jnp.broadcast_to(x, (4,)) for x in box_pos), matvec(bm, local))
