@@ -38,6 +38,11 @@ class GoalEnv(abc.ABC):
 
     moves_fingers = False  # whether the last action opens and closes fingers (a learner may explore it apart)
 
+    def kernel_fallback(self, error: BaseException) -> str | None:
+        """The task options that avoid a GPU kernel whose compile failed with ``error``; None where the task has
+        no such kernel or the error is another."""
+        return None
+
     def settings(self) -> dict:
         """Every option of this task, defaults included, by name: what a checkpoint records so that a
         resume under changed task defaults is caught, not silently continued. An option that changes

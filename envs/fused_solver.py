@@ -284,16 +284,6 @@ def solve(m, d, kernel: bool, num_warps: int | None = None):
 _MJX_SOLVE = mjx_solver.solve
 
 
-def kernel_failure(task, error: BaseException) -> str | None:
-    """What to run instead, when a GPU's compiler failed on ``task``'s solve kernel (its error names Triton);
-    None for any other failure, or a task whose solve is not the kernel."""
-    if getattr(task, "solver_loops", None) not in ("fused", "gpu-fused") or "triton" not in str(error).lower():
-        return None
-    first = str(error).strip().splitlines()[0][:200] if str(error).strip() else type(error).__name__
-    return (f"solver_loops=gpu-search (--env-options) on this GPU, whose compiler failed on the solve's Triton "
-            f"kernel ({first})")  # fmt: skip
-
-
 @contextlib.contextmanager
 def fused_in_mjx(enabled: bool = True, kernel: bool = False):
     """Within the block, MJX's forward dynamics solve through ``solve`` (as a Pallas kernel if ``kernel``).

@@ -346,6 +346,17 @@ class _FetchTask(GoalEnv):
         with self.solver_in_mjx():
             return mjx_substeps(model, data, phys.replace(ctrl=ctrl), self.substeps)
 
+    def kernel_fallback(self, error: BaseException) -> str | None:
+        """The options that leave the physics' Triton kernels out, when a GPU's compiler failed on one (its error
+        names Triton)."""
+        kernels = ("fused", "gpu-fused")
+        options = [f"{name}={mjx_own}" for name, mjx_own in (("solver_loops", "gpu-search"), ("collision", "mjx"))
+                   if getattr(self, name) in kernels]  # fmt: skip
+        if not options or "triton" not in str(error).lower():
+            return None
+        first = str(error).strip().splitlines()[0][:200] if str(error).strip() else type(error).__name__
+        return f"{','.join(options)} (--env-options) on this GPU, whose compiler failed on a physics kernel ({first})"
+
     @contextlib.contextmanager
     def solver_in_mjx(self):
         """Within the block (a trace of MJX calls), MJX factors, solves and collides boxes as this task's

@@ -28,7 +28,6 @@ import jax.numpy as jnp
 import numpy as np
 
 import envs
-from envs import fused_solver
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 from splid_jax.learners import registry
@@ -275,8 +274,8 @@ class _Loop:
         t0 = time.perf_counter()
         try:
             compiled = self.signals.wait(lambda: traced.lower().compile())
-        except Exception as e:  # re-raised unless it is the solve kernel's
-            hint = fused_solver.kernel_failure(self.env, e)
+        except Exception as e:  # re-raised unless it is a physics kernel's
+            hint = self.env.kernel_fallback(e)
             if hint is None:
                 raise
             raise InvalidConfig("env_options", cfg.env_options, hint) from e

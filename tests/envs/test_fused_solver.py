@@ -118,10 +118,13 @@ def test_push_default_solves_through_the_kernel_on_a_gpu_only(monkeypatch):
     assert fused_solver.chosen("fused", "cpu") and not fused_solver.chosen("gpu-search", "gpu")
 
 
-def test_a_kernel_compile_failure_names_the_option_that_avoids_it():
+def test_a_kernel_compile_failure_names_the_options_that_avoid_it():
     error = RuntimeError("INTERNAL: Triton compilation failed\nmore")
-    hint = fused_solver.kernel_failure(envs.make("push"), error)
-    assert "solver_loops=gpu-search" in hint and "Triton compilation failed" in hint and "more" not in hint
-    assert fused_solver.kernel_failure(envs.make("push"), RuntimeError("RESOURCE_EXHAUSTED: out of memory")) is None
-    assert fused_solver.kernel_failure(envs.make("push", solver_loops="gpu-search"), error) is None
-    assert fused_solver.kernel_failure(envs.make("point"), error) is None
+    hint = envs.make("push").kernel_fallback(error)
+    assert "solver_loops=gpu-search" in hint and "collision" not in hint
+    assert "Triton compilation failed" in hint and "more" not in hint
+    both = envs.make("push", collision="gpu-fused").kernel_fallback(error)
+    assert "solver_loops=gpu-search,collision=mjx" in both
+    assert envs.make("push").kernel_fallback(RuntimeError("RESOURCE_EXHAUSTED: out of memory")) is None
+    assert envs.make("push", solver_loops="gpu-search").kernel_fallback(error) is None
+    assert envs.make("point").kernel_fallback(error) is None

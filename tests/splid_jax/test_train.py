@@ -404,13 +404,13 @@ def test_a_full_disk_is_one_line_exit_3_and_keeps_the_last_whole_checkpoint(tmp_
 
 
 def test_a_gpu_compiler_failing_on_the_solve_kernel_is_one_line(tmp_path, capsys, monkeypatch):
-    from envs import fused_solver
+    from envs.base import GoalEnv
 
     def compile_fails(self):
         raise RuntimeError("INTERNAL: Triton compilation failed for the kernel\n(a long log)")
 
     monkeypatch.setattr(jax.stages.Lowered, "compile", compile_fails)
-    monkeypatch.setattr(fused_solver, "kernel_failure", lambda task, e: "another solver (" + str(e).split()[1] + ")")
+    monkeypatch.setattr(GoalEnv, "kernel_fallback", lambda self, e: "another solver (" + str(e).split()[1] + ")")
     assert main([*TINY, "--iterations", "5", "--run-dir", str(tmp_path / "run")]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "env_options" in err and "another solver (Triton)" in err
