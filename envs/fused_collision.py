@@ -20,6 +20,7 @@ amplifies rounding, as it does between MJX's own variants (``tests/envs/test_fus
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 
 import jax
@@ -448,3 +449,15 @@ def fused_in_mjx(enabled: bool = True, kernel: bool = False):
             yield
         finally:
             table.update(saved)
+
+
+def contacts(task, physics, fused: bool):
+    """(dist, pos, frame) of MJX's contacts for one env of a Fetch ``task`` at its ``physics`` state, collided by
+    MJX's functions or, if ``fused``, by this module's: what the parity checks compare."""
+    from mujoco import mjx
+
+    names = [f.name for f in dataclasses.fields(physics)]
+    data = mjx.make_data(task.mjx_model).replace(**{n: getattr(physics, n) for n in names})
+    with fused_in_mjx(fused):
+        c = mjx.forward(task.mjx_model, data)._impl.contact
+    return c.dist, c.pos, c.frame

@@ -23,9 +23,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
-    from mujoco import mjx
-
-import envs  # noqa: E402
+    import envs
 from envs import fused_collision  # noqa: E402
 from envs.fetch.scripted import CONTROLLERS  # noqa: E402
 
@@ -45,15 +43,7 @@ def main() -> None:
     env = envs.make(a.task, solver_loops="loops")
     state = jax.jit(jax.vmap(env.reset))(jax.random.split(jax.random.PRNGKey(a.seed), a.envs))
     act, step = jax.jit(jax.vmap(CONTROLLERS[env.kind])), jax.jit(jax.vmap(env.step))
-    names = list(state.physics.__dataclass_fields__)
-
-    def contacts(physics, fused: bool):
-        data = mjx.make_data(env.mjx_model).replace(**{n: getattr(physics, n) for n in names})
-        with fused_collision.fused_in_mjx(fused):
-            c = mjx.forward(env.mjx_model, data)._impl.contact
-        return c.dist, c.pos, c.frame
-
-    mjxs, ours = (jax.jit(jax.vmap(lambda s, f=f: contacts(s, f))) for f in (False, True))
+    mjxs, ours = (jax.jit(jax.vmap(lambda s, f=f: fused_collision.contacts(env, s, f))) for f in (False, True))
     for k in range(1, max(a.steps) + 1):
         state = step(state, act(state.obs, state.desired_goal))
         if k in a.steps:

@@ -9,7 +9,6 @@ import functools
 import jax
 import jax.numpy as jnp
 import numpy as np
-from mujoco import mjx
 from mujoco.mjx._src import collision_convex, collision_driver, math, mesh
 from mujoco.mjx._src.collision_types import GeomInfo
 
@@ -92,14 +91,7 @@ def test_push_states_get_mjxs_contacts():
     env = envs.make("push", solver_loops="loops")
     state = jax.jit(jax.vmap(env.reset))(jax.random.split(jax.random.PRNGKey(0), 8))
     act, step = jax.jit(jax.vmap(CONTROLLERS["push"])), jax.jit(jax.vmap(env.step))
-    names = list(state.physics.__dataclass_fields__)
-
-    def contacts(physics, fused: bool):
-        data = mjx.make_data(env.mjx_model).replace(**{n: getattr(physics, n) for n in names})
-        with fused_collision.fused_in_mjx(fused):
-            c = mjx.forward(env.mjx_model, data)._impl.contact
-        return c.dist, c.pos, c.frame
-
+    contacts = functools.partial(fused_collision.contacts, env)
     mjxs, ours = (jax.jit(jax.vmap(functools.partial(contacts, fused=f))) for f in (False, True))
     touching = 0
     for k in range(8):  # the finger block meets the cube from the seventh step on
