@@ -422,11 +422,6 @@ def _plane_box_group(m, d, key, geom, kernel: bool):
     return dist.reshape(-1), pos.reshape(-1, 3), frame.reshape(-1, 3, 3)
 
 
-def chosen(choice: str, backend: str) -> bool:
-    """Whether a task's ``collision`` choice collides boxes here: ``fused`` always, ``gpu-fused`` on a GPU only."""
-    return choice == "fused" or (choice == "gpu-fused" and backend == "gpu")
-
-
 @contextlib.contextmanager
 def fused_in_mjx(enabled: bool = True, kernel: bool = False):
     """Within the block, MJX's collision driver collides planes with boxes and boxes with boxes through

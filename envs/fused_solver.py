@@ -263,12 +263,6 @@ def covers(m, d) -> bool:
     )
 
 
-def chosen(choice: str, backend: str) -> bool:
-    """Whether a task's ``solver_loops`` choice solves through ``solve`` on ``backend``: ``fused`` always,
-    ``gpu-fused`` on a GPU only (on a CPU the kernel runs as XLA code, slower than MJX's loops)."""
-    return choice == "fused" or (choice == "gpu-fused" and backend == "gpu")
-
-
 def solve(m, d, kernel: bool, num_warps: int | None = None):
     """``mujoco.mjx._src.solver.solve`` for the models ``covers`` takes, through ``kernel_solve`` if ``kernel``."""
     if not covers(m, d):

@@ -30,7 +30,7 @@ MAX_UNROLLED = 16
 MIN_PIVOT = 1e-15  # mjMINVAL: MuJoCo's floor for a Cholesky pivot
 
 _LIBRARY = (jsl.cho_factor, jsl.cho_solve)
-TRACE_LOCK = threading.RLock()  # held while MJX's functions are swapped for a trace (also solver_loops, fused_solver)
+TRACE_LOCK = threading.RLock()  # held while MJX's functions are swapped for a trace (also solver_loops, fused_*)
 
 
 def lower_factor(a: jax.Array) -> jax.Array:

@@ -46,7 +46,16 @@ CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linal
 # MJX's solver loops, both written out, the line search alone written out, each of the last two on a GPU only, and
 # the whole solve as one program per env (envs/fused_solver.py), always or on a GPU only
 SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused", "gpu-fused")
-COLLISION = ("mjx", "fused", "gpu-fused")  # box-box contacts: MJX's, or envs/fused_collision.py always or on a GPU
+# plane-box and box-box contacts: MJX's, or envs/fused_collision.py always or on a GPU only
+COLLISION = ("mjx", "fused", "gpu-fused")
+KERNELS = ("fused", "gpu-fused")  # the choices above that run a part of the physics as a Pallas kernel
+
+
+def runs_as_kernel(choice: str, backend: str) -> bool:
+    """Whether a ``solver_loops`` or ``collision`` choice runs its part as envs/fused_*.py's function on ``backend``:
+    ``fused`` always, ``gpu-fused`` on a GPU only (on a CPU their functions run as XLA code, where MJX's solver
+    loops are faster)."""
+    return choice == "fused" or (choice == "gpu-fused" and backend == "gpu")
 
 
 @struct.dataclass
@@ -114,8 +123,8 @@ class _FetchTask(GoalEnv):
     # Pallas kernel on a GPU (fused; on a GPU only, MJX's loops on a CPU: gpu-fused; envs/fused_solver.py):
     # equal to float rounding
     solver_loops: str = experimental("gpu-search", numerics_only=True)
-    # box-box contacts as MJX computes them, or as one program per pair, a Pallas kernel on a GPU (fused; on a GPU
-    # only: gpu-fused; envs/fused_collision.py): the same contacts up to MJX's float ties
+    # plane-box and box-box contacts as MJX computes them, or as one program per pair, a Pallas kernel on a GPU
+    # (fused; on a GPU only: gpu-fused; envs/fused_collision.py): the same contacts up to MJX's float ties
     collision: str = experimental("mjx", numerics_only=True)
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
@@ -349,9 +358,8 @@ class _FetchTask(GoalEnv):
     def kernel_fallback(self, error: BaseException) -> str | None:
         """The options that leave the physics' Triton kernels out, when a GPU's compiler failed on one (its error
         names Triton)."""
-        kernels = ("fused", "gpu-fused")
         options = [f"{name}={mjx_own}" for name, mjx_own in (("solver_loops", "gpu-search"), ("collision", "mjx"))
-                   if getattr(self, name) in kernels]  # fmt: skip
+                   if getattr(self, name) in KERNELS]  # fmt: skip
         if not options or "triton" not in str(error).lower():
             return None
         first = str(error).strip().splitlines()[0][:200] if str(error).strip() else type(error).__name__
@@ -366,8 +374,8 @@ class _FetchTask(GoalEnv):
         with (
             small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"),
             solver_loops.unrolled_in_mjx(self.iterations, newton, line_search),
-            fused_solver.fused_in_mjx(fused_solver.chosen(self.solver_loops, backend), kernel=backend == "gpu"),
-            fused_collision.fused_in_mjx(fused_collision.chosen(self.collision, backend), kernel=backend == "gpu"),
+            fused_solver.fused_in_mjx(runs_as_kernel(self.solver_loops, backend), kernel=backend == "gpu"),
+            fused_collision.fused_in_mjx(runs_as_kernel(self.collision, backend), kernel=backend == "gpu"),
         ):
             yield
 

@@ -15,6 +15,7 @@ from mujoco.mjx._src.collision_types import GeomInfo
 import envs
 from envs import fused_collision
 from envs.fetch.scripted import CONTROLLERS
+from envs.fetch.tasks import runs_as_kernel
 from tests.helpers import triton_calls_in_step
 
 
@@ -131,7 +132,7 @@ def test_driver_keeps_mjxs_function_outside_the_block():
         swapped = {k for k, f in collision_driver._COLLISION_FUNC.items() if f is not before[k]}
         assert swapped == {(0, 6), (6, 6)}  # plane-box and box-box
     assert collision_driver._COLLISION_FUNC == before
-    assert [fused_collision.chosen("gpu-fused", b) for b in ("gpu", "cpu")] == [True, False]
+    assert [runs_as_kernel("gpu-fused", b) for b in ("gpu", "cpu")] == [True, False]
 
 
 def test_push_collides_boxes_in_a_kernel_on_a_gpu_when_asked(monkeypatch):
