@@ -101,9 +101,19 @@ def _argmax(x, index):
     return _first_index(x == jnp.max(x), index)
 
 
+def _at(x, index, i):
+    """x[i] for an array ``x`` of ``index``'s shape, as a masked sum (a Triton kernel has no gather)."""
+    return jnp.sum(jnp.where(index == i, x, 0.0))
+
+
 def _pick(a, index, i):
-    """a[i] for a vector ``a`` whose components share ``index``'s shape (masked sum)."""
-    return tuple(jnp.sum(jnp.where(index == i, x, 0.0)) for x in a)
+    """a[i] for a vector ``a`` whose components share ``index``'s shape."""
+    return tuple(_at(x, index, i) for x in a)
+
+
+def _corner(index, c: int, dtype):
+    """Coordinate c (-1 or 1) of mesh.box's unit vertex ``index``: its bit 2 - c is the sign."""
+    return ((index >> (2 - c)) & 1).astype(dtype) * 2 - 1
 
 
 def _row_of(a, index, i):
@@ -222,7 +232,7 @@ def box_box_soa(pos1, mat1, size1, pos2, mat2, size2):
     t = _matvec(m2t, _sub(pos1, pos2))
     # box 1's vertices and faces in box 2's frame, box 2's in its own
     vi = jnp.arange(8)
-    vert = tuple(((vi >> (2 - c)) & 1).astype(t[0].dtype) * 2 - 1 for c in range(3))
+    vert = tuple(_corner(vi, c, t[0].dtype) for c in range(3))
     va = _add(t, _matvec(rel, tuple(vert[i] * s1[i] for i in range(3))))
     vb = tuple(vert[i] * s2[i] for i in range(3))
     fi, ki = jnp.arange(NF)[:, None], jnp.arange(4)[None, :]
@@ -230,7 +240,7 @@ def box_box_soa(pos1, mat1, size1, pos2, mat2, size2):
     for f in range(6):
         for k in range(4):
             face_vi = jnp.where((fi == f) & (ki == k), int(_FACE[f, k]), face_vi)
-    face_unit = tuple(((face_vi >> (2 - c)) & 1).astype(t[0].dtype) * 2 - 1 for c in range(3))  # [8, 4]
+    face_unit = tuple(_corner(face_vi, c, t[0].dtype) for c in range(3))  # [8, 4]
     fa = _add(tuple(x[..., None, None] for x in t), _matvec(rel, tuple(face_unit[i] * s1[i] for i in range(3))))
     fb = tuple(face_unit[i] * s2[i] for i in range(3))
     f8 = jnp.arange(NF)
@@ -245,7 +255,7 @@ def box_box_soa(pos1, mat1, size1, pos2, mat2, size2):
     degenerate = ax_i >= 21
     for f in range(6):
         for c in range(3):
-            axes[c] = jnp.where(ax_i == f, jnp.sum(jnp.where(jnp.arange(NF) == f, na[c], 0.0)), axes[c])
+            axes[c] = jnp.where(ax_i == f, _at(na[c], jnp.arange(NF), f), axes[c])
             axes[c] = jnp.where(ax_i == 6 + f, float(_NORMAL[f, c]), axes[c])
     for q in range(9):
         cr = _cross(ea[q % 3], eb[q // 3])
@@ -265,7 +275,7 @@ def box_box_soa(pos1, mat1, size1, pos2, mat2, size2):
     best_face_idx = _argmin(jnp.where(ax_i < 12, support, BIG), ax_i)
     best_face_axis = _pick(axes, ax_i, best_face_idx)
     best_idx = _argmin(support, ax_i)
-    best_sign = jnp.sum(jnp.where(ax_i == best_idx, sign, 0.0))
+    best_sign = _at(sign, ax_i, best_idx)
     best_axis = _pick(axes, ax_i, best_idx)
     is_edge = (best_idx >= 12) & (jnp.abs(_dot(best_face_axis, best_axis)) < 0.99)
     f_i = jnp.arange(NF)
@@ -304,14 +314,14 @@ def plane_box_soa(plane_pos, plane_mat, box_pos, box_mat, box_size):
     normal = (pm[0][2], pm[1][2], pm[2][2])  # the plane's z axis
     local_pos, n = _matvec(bmt, _sub(plane_pos, box_pos)), _matvec(bmt, normal)
     vi = jnp.arange(8)
-    vert = tuple((((vi >> (2 - c)) & 1).astype(size[0].dtype) * 2 - 1) * size[c] for c in range(3))
+    vert = tuple(_corner(vi, c, size[0].dtype) * size[c] for c in range(3))
     support = _dot(_sub(tuple(jnp.broadcast_to(x, (8,)) for x in local_pos), vert), n)
     mask = support > jnp.maximum(0.0, jnp.max(support) - 1e-3)  # manifold points within a 1 mm skin
     best = _manifold(vert, mask, n, vi, 8)
     i4 = jnp.arange(4)
     idx = _vec4(best)
     local = tuple(_vec4([_pick(vert, vi, i)[c] for i in best]) for c in range(3))
-    depth = _vec4([jnp.sum(jnp.where(vi == i, support, 0.0)) for i in best])
+    depth = _vec4([_at(support, vi, i) for i in best])
     earlier = sum(jnp.where((i4 > j) & (idx == best[j]), 1, 0) for j in range(4))  # a point chosen before
     dist = jnp.where(earlier == 0, -depth, 0.0 * depth + 1.0)
     world = _add(tuple(jnp.broadcast_to(x, (4,)) for x in box_pos), _matvec(bm, local))
@@ -362,7 +372,7 @@ def _kernel(soa_fn, *args, interpret=False, num_warps=None):
     def kernel(in_ref, out_ref):
         x = in_ref[...]
         i32 = jnp.arange(32)
-        v = [jnp.sum(jnp.where(i32 == k, x, 0.0)) for k in range(flat.shape[0])]
+        v = [_at(x, i32, k) for k in range(flat.shape[0])]
         values, at = [], 0
         for shape in shapes:
             if shape == (3,):
@@ -375,7 +385,7 @@ def _kernel(soa_fn, *args, interpret=False, num_warps=None):
         out = jnp.zeros((32,), x.dtype)
         for blk, arr in enumerate((dist, *world)):
             for i in range(4):
-                out = jnp.where(i32 == blk * 4 + i, jnp.sum(jnp.where(i4 == i, arr, 0.0)), out)
+                out = jnp.where(i32 == blk * 4 + i, _at(arr, i4, i), out)
         for r in range(3):
             for c in range(3):
                 out = jnp.where(i32 == 16 + 3 * r + c, rows[r][c], out)
