@@ -31,6 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
     import envs
+from bench_env import parse_variant  # noqa: E402  this folder's scripts share their parsing
 
 
 def run(task: str, options: dict, batch: int, steps: int, repeats: int) -> tuple[np.ndarray, dict]:
@@ -58,7 +59,7 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--task", default="push")
     p.add_argument("--choices", nargs="+", default=["gpu-search", "fused"], help="solver_loops values, first the base")
-    p.add_argument("--variants", nargs="+", default=None,
+    p.add_argument("--variants", nargs="+", type=parse_variant, default=None,
                    help="task options per variant as KEY=VALUE[,KEY=VALUE] ('' for the defaults), first the base; "
                         "replaces --choices")  # fmt: skip
     p.add_argument("--batch", type=int, default=64)
@@ -68,11 +69,10 @@ def main() -> None:
     a = p.parse_args()
     print(f"device {jax.devices()[0].device_kind}, jax {jax.__version__}, {a.task}, {a.batch} envs, {a.steps} steps")
     rows, base = [], None
-    variants = a.variants if a.variants is not None else [f"solver_loops={c}" for c in a.choices]
-    for variant in variants:
-        options = dict(item.split("=", 1) for item in variant.split(",") if item)
+    variants = a.variants if a.variants is not None else [parse_variant(f"solver_loops={c}") for c in a.choices]
+    for label, options in variants:
         path, row = run(a.task, options, a.batch, a.steps, a.repeats)
-        row = {"variant": variant or "default", **row}
+        row = {"variant": label, **row}
         if base is None:
             base = path
         else:
