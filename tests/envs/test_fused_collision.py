@@ -72,20 +72,19 @@ def test_box_box_makes_mjxs_contacts():
 
 def test_kernels_are_the_functions_and_lower_as_one_triton_call_each():
     args = _pairs(12, seed=1)
-    plain = jax.jit(jax.vmap(fused_collision.box_box))(*args)
-    kernel = jax.jit(jax.vmap(functools.partial(fused_collision.kernel_box_box, interpret=True)))(*args)
-    for i in range(12):
-        assert _contacts(*kernel[:2], i) == _contacts(*plain[:2], i)
-    lowered = jax.jit(jax.vmap(fused_collision.kernel_box_box)).trace(*args).lower(lowering_platforms=("cuda",))
-    assert lowered.as_text().count("xla.gpu.triton") == 1
     plane = (args[3], args[4], *args[:3])  # the second box's frame as a plane, the first box on it
-    plain = jax.jit(jax.vmap(fused_collision.plane_box))(*plane)
-    kernel = jax.jit(jax.vmap(functools.partial(fused_collision.kernel_plane_box, interpret=True)))(*plane)
-    assert int((np.asarray(plain[0]) < 0).sum()) > 0
-    for i in range(12):
-        assert _contacts(*kernel[:2], i) == _contacts(*plain[:2], i)
-    lowered = jax.jit(jax.vmap(fused_collision.kernel_plane_box)).trace(*plane).lower(lowering_platforms=("cuda",))
-    assert lowered.as_text().count("xla.gpu.triton") == 1
+    cases = [
+        (fused_collision.box_box, fused_collision.kernel_box_box, args),
+        (fused_collision.plane_box, fused_collision.kernel_plane_box, plane),
+    ]
+    for function, kernel_fn, inputs in cases:
+        plain = jax.jit(jax.vmap(function))(*inputs)
+        kernel = jax.jit(jax.vmap(functools.partial(kernel_fn, interpret=True)))(*inputs)
+        assert int((np.asarray(plain[0]) < 0).sum()) > 0
+        for i in range(12):
+            assert _contacts(*kernel[:2], i) == _contacts(*plain[:2], i)
+        lowered = jax.jit(jax.vmap(kernel_fn)).trace(*inputs).lower(lowering_platforms=("cuda",))
+        assert lowered.as_text().count("xla.gpu.triton") == 1
 
 
 def test_push_states_get_mjxs_contacts():
