@@ -147,6 +147,11 @@ def step_batch(env: GoalEnv, state: State, action: jax.Array) -> State:
     return jax.tree.map(lambda x: x[:n], out) if pad else out
 
 
+def data_with(data, phys):
+    """MJX ``data`` with the fields of a task's ``phys`` (a flax struct named as MJX's ``Data`` fields) set."""
+    return data.replace(**{f.name: getattr(phys, f.name) for f in dataclasses.fields(phys)})
+
+
 def mjx_substeps(model, data, phys, substeps: int):
     """``substeps`` MJX steps of ``model`` from ``data`` with the fields of the task's ``phys`` (a flax
     struct named as MJX's ``Data`` fields) set; returns ``phys`` with those fields as they end.
@@ -160,7 +165,7 @@ def mjx_substeps(model, data, phys, substeps: int):
     names = [f.name for f in dataclasses.fields(phys)]
 
     def substep(_, p):
-        d = mjx.step(model, data.replace(**{n: getattr(p, n) for n in names}))
+        d = mjx.step(model, data_with(data, p))
         return p.replace(**{n: getattr(d, n) for n in names})
 
     return jax.lax.fori_loop(0, substeps, substep, phys)

@@ -20,13 +20,13 @@ amplifies rounding, as it does between MJX's own variants (``tests/envs/test_fus
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import functools
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
+from envs.base import data_with
 from envs.small_cholesky import TRACE_LOCK
 
 _FACE = np.array([0, 4, 5, 1, 0, 2, 6, 4, 6, 7, 5, 4, 2, 3, 7, 6, 1, 5, 7, 3, 0, 1, 3, 2]).reshape(6, 4)
@@ -461,8 +461,7 @@ def contacts(task, physics, fused: bool):
     MJX's functions or, if ``fused``, by this module's: what the parity checks compare."""
     from mujoco import mjx
 
-    names = [f.name for f in dataclasses.fields(physics)]
-    data = mjx.make_data(task.mjx_model).replace(**{n: getattr(physics, n) for n in names})
+    data = data_with(mjx.make_data(task.mjx_model), physics)
     with fused_in_mjx(fused):
         c = mjx.forward(task.mjx_model, data)._impl.contact
     return c.dist, c.pos, c.frame

@@ -35,6 +35,7 @@ with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on i
 
 import envs  # noqa: E402
 from envs import fused_solver, small_cholesky  # noqa: E402
+from envs.base import data_with  # noqa: E402
 from envs.fetch.scripted import CONTROLLERS  # noqa: E402
 
 
@@ -45,10 +46,9 @@ def presolve_states(env, batch: int, steps: int, seed: int):
     for _ in range(steps):
         state = step(state, act(state.obs, state.desired_goal))
     model, phys = env.mjx_model, state.physics
-    names = list(phys.__dataclass_fields__)
 
     def before_solve(p):
-        data = mjx.make_data(model).replace(**{n: getattr(p, n) for n in names})
+        data = data_with(mjx.make_data(model), p)
         with small_cholesky.TRACE_LOCK:  # MJX's forward dynamics with its solve left out
             saved, mjx_solver.solve = mjx_solver.solve, lambda m, d: d
             try:
