@@ -37,6 +37,7 @@ import envs  # noqa: E402
 from envs import fused_solver, small_cholesky  # noqa: E402
 from envs.base import data_with  # noqa: E402
 from envs.fetch.scripted import CONTROLLERS  # noqa: E402
+from envs.fetch.tasks import KERNELS  # noqa: E402
 
 
 def presolve_states(env, batch: int, steps: int, seed: int):
@@ -95,11 +96,13 @@ def main() -> None:
     p.add_argument("--out", type=Path, default=None)
     a = p.parse_args()
     env = envs.make(a.task)
+    if env.solver_loops in KERNELS:  # MJX's own solve as the task would run it without the kernel
+        env = envs.make(a.task, solver_loops="gpu-search")
     model = env.mjx_model
     gpu = jax.default_backend() == "gpu"
 
     def mjx_solve(d):
-        with env.solver_in_mjx():  # the task's default solver_loops: MJX's own solve
+        with env.solver_in_mjx():
             return mjx_solver.solve(model, d)
 
     variants = {f"mjx ({env.solver_loops})": mjx_solve}
