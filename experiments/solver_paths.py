@@ -9,7 +9,7 @@ float rounding, so a few envs part after some steps whichever variant is compare
 whether the arithmetic is the same.
 
     python experiments/solver_paths.py --task push --batch 64 --steps 50 --choices gpu-search unrolled fused
-    python experiments/solver_paths.py --task push --variants "" collision=gpu-fused   # the task's default first
+    python experiments/solver_paths.py --task push --variants "" collision=mjx   # the task's default first
     python experiments/solver_paths.py --batch 4 --steps 5 --repeats 1    # CPU smoke test
 """
 

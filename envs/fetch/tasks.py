@@ -419,8 +419,9 @@ class Push(_FetchTask):
 
     finger_table: float = 1.0
     finger: str = "pads"
-    # the solve as one kernel on a GPU, where Push's step was measured twice as fast (BENCHMARKS.md)
+    # the solve and the box contacts as kernels on a GPU, where each made Push's step faster (BENCHMARKS.md)
     solver_loops: str = experimental("gpu-fused", numerics_only=True)
+    collision: str = experimental("gpu-fused", numerics_only=True)
     kind = "push"
 
 

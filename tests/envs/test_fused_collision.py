@@ -134,6 +134,6 @@ def test_driver_keeps_mjxs_function_outside_the_block():
     assert [runs_as_kernel("gpu-fused", b) for b in ("gpu", "cpu")] == [True, False]
 
 
-def test_push_collides_boxes_in_a_kernel_on_a_gpu_when_asked(monkeypatch):
-    env = envs.make("push", substeps=1, collision="gpu-fused")
+def test_push_collides_boxes_in_kernels_on_a_gpu_by_default(monkeypatch):
+    env = envs.make("push", substeps=1)
     assert triton_calls_in_step(env, monkeypatch) == (0, 3)  # plane-box and box-box contacts, the constraint solve

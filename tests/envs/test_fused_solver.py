@@ -114,18 +114,19 @@ def test_solve_has_no_while_loop():
 
 
 def test_push_default_solves_through_the_kernel_on_a_gpu_only(monkeypatch):
-    assert triton_calls_in_step(envs.make("push", substeps=1), monkeypatch) == (0, 1)
+    env = envs.make("push", substeps=1, collision="mjx")
+    assert triton_calls_in_step(env, monkeypatch) == (0, 1)
     assert [runs_as_kernel("gpu-fused", b) for b in ("gpu", "cpu")] == [True, False]
     assert runs_as_kernel("fused", "cpu") and not runs_as_kernel("gpu-search", "gpu")
 
 
 def test_a_kernel_compile_failure_names_the_options_that_avoid_it():
     error = RuntimeError("INTERNAL: Triton compilation failed\nmore")
-    hint = envs.make("push").kernel_fallback(error)
+    hint = envs.make("push", collision="mjx").kernel_fallback(error)
     assert "solver_loops=gpu-search" in hint and "collision" not in hint
     assert "Triton compilation failed" in hint and "more" not in hint
-    both = envs.make("push", collision="gpu-fused").kernel_fallback(error)
+    both = envs.make("push").kernel_fallback(error)
     assert "solver_loops=gpu-search,collision=mjx" in both
     assert envs.make("push").kernel_fallback(RuntimeError("RESOURCE_EXHAUSTED: out of memory")) is None
-    assert envs.make("push", solver_loops="gpu-search").kernel_fallback(error) is None
+    assert envs.make("push", solver_loops="gpu-search", collision="mjx").kernel_fallback(error) is None
     assert envs.make("point").kernel_fallback(error) is None
