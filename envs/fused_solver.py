@@ -263,10 +263,13 @@ def covers(m, d) -> bool:
     )
 
 
-def solve(m, d, kernel: bool, num_warps: int | None = None):
-    """``mujoco.mjx._src.solver.solve`` for the models ``covers`` takes, through ``kernel_solve`` if ``kernel``."""
+def solve(m, d, kernel: bool, num_warps: int | None = None, max_envs: int = 0):
+    """``mujoco.mjx._src.solver.solve`` for the models ``covers`` takes, through ``kernel_solve`` if ``kernel``;
+    with ``max_envs`` the kernel only where the innermost ``vmap`` holds at most that many envs."""
     if not covers(m, d):
         return _MJX_SOLVE(m, d)
+    if kernel and max_envs:
+        return _by_batch(m, d, num_warps, max_envs)
     opts = dict(iterations=int(m.opt.iterations), ls_iterations=int(m.opt.ls_iterations),
                 tolerance=float(m.opt.tolerance), ls_tolerance=float(m.opt.ls_tolerance))  # fmt: skip
     args = (d._impl.efc_J, d._impl.efc_D, d._impl.efc_aref, support.full_m(m, d), d.qfrc_smooth, d.qacc_smooth,
@@ -275,19 +278,38 @@ def solve(m, d, kernel: bool, num_warps: int | None = None):
     return d.tree_replace({"qfrc_constraint": qfrc, "qacc": qacc, "_impl.efc_force": force})
 
 
+def _by_batch(m, d, num_warps, max_envs):
+    """The kernel (one env per program) at batches up to ``max_envs`` and MJX's batched solve above, where it
+    fills the GPU better (BENCHMARKS.md, "The solve kernel at large batches"). The choice is made when ``vmap``
+    batches the solve and sees its size; an enclosing ``vmap`` (a sweep's members) batches the chosen one."""
+
+    @jax.custom_batching.custom_vmap
+    def one(d):
+        return solve(m, d, True, num_warps)
+
+    @one.def_vmap
+    def batched(axis_size, in_batched, d):
+        chosen = (lambda x: solve(m, x, True, num_warps)) if axis_size <= max_envs else (lambda x: _MJX_SOLVE(m, x))
+        out = jax.vmap(chosen, in_axes=(jax.tree.map(lambda b: 0 if b else None, in_batched[0]),))(d)
+        return out, jax.tree.map(lambda _: True, out)
+
+    return one(d)
+
+
 _MJX_SOLVE = mjx_solver.solve
 
 
 @contextlib.contextmanager
-def fused_in_mjx(enabled: bool = True, kernel: bool = False):
-    """Within the block, MJX's forward dynamics solve through ``solve`` (as a Pallas kernel if ``kernel``).
-    MJX looks ``solver.solve`` up when its code runs, which under ``jit`` is trace time only."""
+def fused_in_mjx(enabled: bool = True, kernel: bool = False, max_envs: int = 0):
+    """Within the block, MJX's forward dynamics solve through ``solve`` (as a Pallas kernel if ``kernel``, at
+    batches up to ``max_envs`` if not 0). MJX looks ``solver.solve`` up when its code runs, which under ``jit``
+    is trace time only."""
     if not enabled:
         yield
         return
 
     def fused_solve(m, d):  # MJX's named scope takes this name: profiles file the kernel under it
-        return solve(m, d, kernel)
+        return solve(m, d, kernel, max_envs=max_envs)
 
     with TRACE_LOCK:
         mjx_solver.solve = fused_solve

@@ -41,11 +41,12 @@ def writes_out(choice: str, backend: str) -> tuple[bool, bool]:
     loop, so its body is traced once and the compile grows little. ``gpu-search`` (the Fetch tasks'
     default) and ``auto`` write out the line search, or both, on a GPU only, where the loops' host
     round trips cost; an XLA:CPU loop reads no condition back, and the written-out solver there
-    compiles twice as long and steps slower. ``fused`` and ``gpu-fused`` write none out: where they
-    apply, ``envs/fused_solver.py`` replaces the solve, and elsewhere ``gpu-fused`` keeps MJX's loops."""
+    compiles twice as long and steps slower. ``fused`` and ``gpu-fused`` replace MJX's solve with
+    ``envs/fused_solver.py``'s; where MJX's still runs, ``gpu-fused`` is ``gpu-search`` (a GPU's batches
+    above the kernel's ``solve_kernel_envs``; a CPU's solves)."""
     gpu = backend == "gpu"
     newton = choice == "unrolled" or (choice == "auto" and gpu)
-    return newton, newton or choice == "search" or (choice == "gpu-search" and gpu)
+    return newton, newton or choice == "search" or (choice in ("gpu-search", "gpu-fused") and gpu)
 
 
 @contextlib.contextmanager

@@ -63,12 +63,21 @@ def with_counted_jit(learner, compiler_options=None):
     return learner
 
 
-def triton_calls_in_step(env: GoalEnv, monkeypatch) -> tuple[int, int]:
-    """How many Triton kernel calls ``env``'s batched step (4 envs) holds as traced on this CPU and as traced for,
-    and lowered for, a GPU (Pallas's Triton lowering needs no device)."""
-    state = jax.eval_shape(jax.vmap(env.reset), jax.random.split(jax.random.PRNGKey(0), 4))
-    actions = jax.ShapeDtypeStruct((4, env.action_size), jnp.float32)
-    cpu = jax.jit(lambda s, a: jax.vmap(env.step)(s, a)).trace(state, actions).lower().as_text()
-    monkeypatch.setattr(jax, "default_backend", lambda: "gpu")
-    gpu = jax.jit(lambda s, a: jax.vmap(env.step)(s, a)).trace(state, actions).lower(lowering_platforms=("cuda",))
+def triton_calls_in_step(env: GoalEnv, monkeypatch, batch: tuple[int, ...] = (4,)) -> tuple[int, int]:
+    """How many Triton kernel calls ``env``'s step, vmapped over each axis of ``batch`` (envs last), holds as
+    traced on this CPU and as traced for, and lowered for, a GPU (Pallas's Triton lowering needs no device)."""
+    state = jax.eval_shape(jax.vmap(env.reset), jax.random.split(jax.random.PRNGKey(0), batch[-1]))
+    state = jax.tree.map(lambda x: jax.ShapeDtypeStruct(batch[:-1] + x.shape, x.dtype), state)
+    actions = jax.ShapeDtypeStruct((*batch, env.action_size), jnp.float32)
+
+    def batched():  # a new function each time: jit's trace cache would hand the GPU the CPU's trace
+        step = env.step
+        for _ in batch:
+            step = jax.vmap(step)
+        return jax.jit(lambda s, a: step(s, a))
+
+    cpu = batched().trace(state, actions).lower().as_text()
+    with monkeypatch.context() as patched:
+        patched.setattr(jax, "default_backend", lambda: "gpu")
+        gpu = batched().trace(state, actions).lower(lowering_platforms=("cuda",))
     return cpu.count("xla.gpu.triton"), gpu.as_text().count("xla.gpu.triton")

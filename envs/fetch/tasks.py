@@ -123,6 +123,9 @@ class _FetchTask(GoalEnv):
     # Pallas kernel on a GPU (fused; on a GPU only, MJX's loops on a CPU: gpu-fused; envs/fused_solver.py):
     # equal to float rounding
     solver_loops: str = experimental("gpu-search", numerics_only=True)
+    # the most envs in one batch that the solve kernel takes, MJX's batched solve above (0: any batch): one env
+    # per program fills a GPU worse than MJX's batched operations at thousands of envs (BENCHMARKS.md)
+    solve_kernel_envs: int = experimental(0, numerics_only=True)
     # plane-box and box-box contacts as MJX computes them, or as one program per pair, a Pallas kernel on a GPU
     # (fused; on a GPU only: gpu-fused; envs/fused_collision.py): the same contacts up to MJX's float ties
     collision: str = experimental("mjx", numerics_only=True)
@@ -172,6 +175,7 @@ class _FetchTask(GoalEnv):
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
         ok = self.solver_loops in SOLVER_LOOPS
         check(ok, f"{n}.solver_loops", self.solver_loops, "one of " + ", ".join(SOLVER_LOOPS))
+        check_integer(f"{n}.solve_kernel_envs", self.solve_kernel_envs, 0)
         ok = self.collision in COLLISION
         check(ok, f"{n}.collision", self.collision, "one of " + ", ".join(COLLISION))
         grasp_range = "in [0, 1]" if not self.block_gripper else "0 (the fingers are locked on this task)"
@@ -374,7 +378,9 @@ class _FetchTask(GoalEnv):
         with (
             small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"),
             solver_loops.unrolled_in_mjx(self.iterations, newton, line_search),
-            fused_solver.fused_in_mjx(runs_as_kernel(self.solver_loops, backend), kernel=backend == "gpu"),
+            fused_solver.fused_in_mjx(
+                runs_as_kernel(self.solver_loops, backend), kernel=backend == "gpu", max_envs=self.solve_kernel_envs
+            ),
             fused_collision.fused_in_mjx(runs_as_kernel(self.collision, backend), kernel=backend == "gpu"),
         ):
             yield
