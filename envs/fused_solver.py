@@ -26,21 +26,22 @@ from mujoco.mjx._src import solver as mjx_solver
 from mujoco.mjx._src import support
 from mujoco.mjx._src.types import ConeType, DisableBit, SolverType
 
+from envs import kernel_batch
 from envs.small_cholesky import TRACE_LOCK
 
 MINVAL = 1e-15  # mujoco.mjMINVAL
 
 
-def _pick(x, mask):
+def at_mask(x, mask):
     return jnp.sum(jnp.where(mask, x, 0.0))
 
 
-def _row(a, k: int):
+def row_at(a, k: int):
     """a[k, :], picked with a mask."""
     return jnp.sum(jnp.where(jnp.arange(a.shape[0])[:, None] == k, a, 0.0), axis=0)
 
 
-def _col(a, k: int):
+def col_at(a, k: int):
     """a[:, k], picked with a mask."""
     return jnp.sum(jnp.where(jnp.arange(a.shape[1])[None, :] == k, a, 0.0), axis=1)
 
@@ -54,19 +55,19 @@ def chol_solve(a, b, size: int | None = None):
     idx = jnp.arange(n)
     low = jnp.zeros_like(a)
     for k in range(size):  # column k of L from the columns before it
-        s = jnp.sum(jnp.where(idx[None, :] < k, low * _row(low, k)[None, :], 0.0), axis=1)  # sum_{m<k} L[:, m] L[k, m]
-        col = _col(a, k) - s
-        diag = jnp.sqrt(jnp.maximum(_pick(col, idx == k), MINVAL))
+        s = jnp.sum(jnp.where(idx[None, :] < k, low * row_at(low, k)[None, :], 0.0), axis=1)  # sum_{m<k} L[:,m] L[k,m]
+        col = col_at(a, k) - s
+        diag = jnp.sqrt(jnp.maximum(at_mask(col, idx == k), MINVAL))
         newcol = jnp.where(idx == k, diag, jnp.where(idx > k, col / diag, 0.0))
         low = jnp.where(idx[None, :] == k, newcol[:, None], low)
     diag = jnp.sum(jnp.where(idx[:, None] == idx[None, :], low, 0.0), axis=1)
     y = jnp.zeros_like(b)
     for k in range(size):  # forward: L y = b
-        yk = (_pick(b, idx == k) - jnp.sum(jnp.where(idx < k, _row(low, k) * y, 0.0))) / _pick(diag, idx == k)
+        yk = (at_mask(b, idx == k) - jnp.sum(jnp.where(idx < k, row_at(low, k) * y, 0.0))) / at_mask(diag, idx == k)
         y = jnp.where(idx == k, yk, y)
     x = jnp.zeros_like(b)
     for k in reversed(range(size)):  # backward: L^T x = y
-        xk = (_pick(y, idx == k) - jnp.sum(jnp.where(idx > k, _col(low, k) * x, 0.0))) / _pick(diag, idx == k)
+        xk = (at_mask(y, idx == k) - jnp.sum(jnp.where(idx > k, col_at(low, k) * x, 0.0))) / at_mask(diag, idx == k)
         x = jnp.where(idx == k, xk, x)
     return x
 
@@ -207,7 +208,7 @@ def newton(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *, itera
     return c["qacc"], c["qfrc"], c["force"]
 
 
-def _pow2(n: int) -> int:
+def pow2(n: int) -> int:
     return 1 << max(0, (n - 1).bit_length())
 
 
@@ -221,7 +222,7 @@ def kernel_solve(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *,
     from jax.experimental.pallas import triton as pl_triton
 
     nefc, nv = j.shape
-    p, v = _pow2(max(nefc, 16)), _pow2(max(nv, 16))
+    p, v = pow2(max(nefc, 16)), pow2(max(nv, 16))
     f32 = j.dtype
     pad_r = lambda x: jnp.pad(x, (0, p - nefc))  # noqa: E731
     pad_v = lambda x: jnp.pad(x, (0, v - nv))  # noqa: E731
@@ -269,31 +270,14 @@ def solve(m, d, kernel: bool, num_warps: int | None = None, max_envs: int = 0):
     if not covers(m, d):
         return _MJX_SOLVE(m, d)
     if kernel and max_envs:
-        return _by_batch(m, d, num_warps, max_envs)
+        own = lambda x: solve(m, x, True, num_warps)  # noqa: E731
+        return kernel_batch.by_batch(own, lambda x: _MJX_SOLVE(m, x), max_envs)(d)
     opts = dict(iterations=int(m.opt.iterations), ls_iterations=int(m.opt.ls_iterations),
                 tolerance=float(m.opt.tolerance), ls_tolerance=float(m.opt.ls_tolerance))  # fmt: skip
     args = (d._impl.efc_J, d._impl.efc_D, d._impl.efc_aref, support.full_m(m, d), d.qfrc_smooth, d.qacc_smooth,
             d.qacc_warmstart, mjx_solver._trace_m(m, d))  # fmt: skip
     qacc, qfrc, force = kernel_solve(*args, num_warps=num_warps, **opts) if kernel else newton(*args, **opts)
     return d.tree_replace({"qfrc_constraint": qfrc, "qacc": qacc, "_impl.efc_force": force})
-
-
-def _by_batch(m, d, num_warps, max_envs):
-    """The kernel (one env per program) at batches up to ``max_envs`` and MJX's batched solve above, where it
-    fills the GPU better (BENCHMARKS.md, "The solve kernel at large batches"). The choice is made when ``vmap``
-    batches the solve and sees its size; an enclosing ``vmap`` (a sweep's members) batches the chosen one."""
-
-    @jax.custom_batching.custom_vmap
-    def one(d):
-        return solve(m, d, True, num_warps)
-
-    @one.def_vmap
-    def batched(axis_size, in_batched, d):
-        chosen = (lambda x: solve(m, x, True, num_warps)) if axis_size <= max_envs else (lambda x: _MJX_SOLVE(m, x))
-        out = jax.vmap(chosen, in_axes=(jax.tree.map(lambda b: 0 if b else None, in_batched[0]),))(d)
-        return out, jax.tree.map(lambda _: True, out)
-
-    return one(d)
 
 
 _MJX_SOLVE = mjx_solver.solve

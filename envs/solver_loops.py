@@ -43,7 +43,7 @@ def writes_out(choice: str, backend: str) -> tuple[bool, bool]:
     round trips cost; an XLA:CPU loop reads no condition back, and the written-out solver there
     compiles twice as long and steps slower. ``fused`` and ``gpu-fused`` replace MJX's solve with
     ``envs/fused_solver.py``'s; where MJX's still runs, ``gpu-fused`` is ``gpu-search`` (a GPU's batches
-    above the kernel's ``solve_kernel_envs``; a CPU's solves)."""
+    above the task's ``kernel_envs``; a CPU's solves)."""
     gpu = backend == "gpu"
     newton = choice == "unrolled" or (choice == "auto" and gpu)
     return newton, newton or choice == "search" or (choice in ("gpu-search", "gpu-fused") and gpu)

@@ -33,7 +33,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs import fused_collision, fused_solver, small_cholesky, solver_loops
+from envs import fused_cholesky, fused_collision, fused_solver, small_cholesky, solver_loops
 from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
 from envs.fetch import models
 from splid_jax.common.errors import check, check_integer
@@ -42,7 +42,7 @@ MIN_OBJECT_DISTANCE = 0.1  # the object starts at least this far from the grippe
 _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4) ** 64 ~ 2e-7
 GOAL_LIFT_MAX = 0.45
 GRASP_ABOVE_SITE = 0.01  # a grasped cube's centre above the grip site: inside the fingers' 6 cm height
-CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
+CHOLESKY = ("unrolled", "library", "gpu-fused")  # small_cholesky.py, jax.scipy.linalg's, fused_cholesky.py on a GPU
 # MJX's solver loops, both written out, the line search alone written out, each of the last two on a GPU only, and
 # the whole solve as one program per env (envs/fused_solver.py), always or on a GPU only
 SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused", "gpu-fused")
@@ -116,16 +116,17 @@ class _FetchTask(GoalEnv):
     table: str = experimental("plane")
     # the closed finger block's collision shape (Push: pads, box or capsule, see models.py)
     finger: str = experimental("box")
-    # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
+    # how MJX factors its small dense systems: written out (envs/small_cholesky.py), "library", or one Pallas
+    # kernel per factor and per solve on a GPU, written out on a CPU (gpu-fused; envs/fused_cholesky.py)
     cholesky: str = experimental("unrolled")
     # MJX's Newton solver as its loops, written out (unrolled), its line search alone written out (search),
     # or either on a GPU only (auto, gpu-search; envs/solver_loops.py), or the whole solve one program per env, a
     # Pallas kernel on a GPU (fused; on a GPU only, MJX's loops on a CPU: gpu-fused; envs/fused_solver.py):
     # equal to float rounding
     solver_loops: str = experimental("gpu-search", numerics_only=True)
-    # the most envs in one batch that the solve kernel takes, MJX's batched solve above (0: any batch): one env
-    # per program fills a GPU worse than MJX's batched operations at thousands of envs (BENCHMARKS.md)
-    solve_kernel_envs: int = experimental(0, numerics_only=True)
+    # the most envs in one batch that the solve and Cholesky kernels take, XLA's batched code above (0: any
+    # batch): one env per program fills a GPU worse than batched operations at thousands (envs/kernel_batch.py)
+    kernel_envs: int = experimental(0, numerics_only=True)
     # plane-box and box-box contacts as MJX computes them, or as one program per pair, a Pallas kernel on a GPU
     # (fused; on a GPU only: gpu-fused; envs/fused_collision.py): the same contacts up to MJX's float ties
     collision: str = experimental("mjx", numerics_only=True)
@@ -175,7 +176,7 @@ class _FetchTask(GoalEnv):
         check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
         ok = self.solver_loops in SOLVER_LOOPS
         check(ok, f"{n}.solver_loops", self.solver_loops, "one of " + ", ".join(SOLVER_LOOPS))
-        check_integer(f"{n}.solve_kernel_envs", self.solve_kernel_envs, 0)
+        check_integer(f"{n}.kernel_envs", self.kernel_envs, 0)
         ok = self.collision in COLLISION
         check(ok, f"{n}.collision", self.collision, "one of " + ", ".join(COLLISION))
         grasp_range = "in [0, 1]" if not self.block_gripper else "0 (the fingers are locked on this task)"
@@ -362,8 +363,8 @@ class _FetchTask(GoalEnv):
     def kernel_fallback(self, error: BaseException) -> str | None:
         """The options that leave the physics' Triton kernels out, when a GPU's compiler failed on one (its error
         names Triton)."""
-        options = [f"{name}={mjx_own}" for name, mjx_own in (("solver_loops", "gpu-search"), ("collision", "mjx"))
-                   if getattr(self, name) in KERNELS]  # fmt: skip
+        own = (("solver_loops", "gpu-search"), ("collision", "mjx"), ("cholesky", "unrolled"))
+        options = [f"{name}={mjx_own}" for name, mjx_own in own if getattr(self, name) in KERNELS]
         if not options or "triton" not in str(error).lower():
             return None
         first = str(error).strip().splitlines()[0][:200] if str(error).strip() else type(error).__name__
@@ -375,11 +376,13 @@ class _FetchTask(GoalEnv):
         ``cholesky``, ``solver_loops`` and ``collision`` choose, on the backend being traced for."""
         backend = jax.default_backend()
         newton, line_search = solver_loops.writes_out(self.solver_loops, backend)
+        cholesky_kernel = runs_as_kernel(self.cholesky, backend)
         with (
-            small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"),
+            small_cholesky.unrolled_in_mjx(self.cholesky in ("unrolled", "gpu-fused") and not cholesky_kernel),
+            fused_cholesky.fused_in_mjx(cholesky_kernel, max_envs=self.kernel_envs),
             solver_loops.unrolled_in_mjx(self.iterations, newton, line_search),
             fused_solver.fused_in_mjx(
-                runs_as_kernel(self.solver_loops, backend), kernel=backend == "gpu", max_envs=self.solve_kernel_envs
+                runs_as_kernel(self.solver_loops, backend), kernel=backend == "gpu", max_envs=self.kernel_envs
             ),
             fused_collision.fused_in_mjx(runs_as_kernel(self.collision, backend), kernel=backend == "gpu"),
         ):

@@ -125,13 +125,13 @@ def test_push_default_solves_through_the_kernel_on_a_gpu_only(monkeypatch):
 def test_solve_kernel_takes_batches_up_to_its_limit_and_mjx_solves_larger_ones(monkeypatch):
     # one env per program loses to MJX's batched solve at thousands of envs; a sweep's members (the outer
     # axis) do not count against the limit, the envs of one step (the inner axis) do
-    env = envs.make("push", substeps=1, collision="mjx", solve_kernel_envs=8)
+    env = envs.make("push", substeps=1, collision="mjx", kernel_envs=8)
     assert triton_calls_in_step(env, monkeypatch, (8,)) == (0, 1)
     assert triton_calls_in_step(env, monkeypatch, (9,)) == (0, 0)
     assert triton_calls_in_step(env, monkeypatch, (3, 8)) == (0, 1)
     assert triton_calls_in_step(env, monkeypatch, (2, 9)) == (0, 0)
-    with pytest.raises(InvalidConfig, match="solve_kernel_envs"):
-        envs.make("push", solve_kernel_envs=-1)
+    with pytest.raises(InvalidConfig, match="kernel_envs"):
+        envs.make("push", kernel_envs=-1)
 
 
 def test_a_batch_above_the_kernels_limit_is_mjxs_own_solve():
