@@ -2,8 +2,8 @@
 
 Why: a Fetch substep factors the mass matrix twice (``factor_m``, and ``euler``'s implicit damping) and solves
 with it twice; written out element by element (``envs/small_cholesky.py``) XLA makes each a handful of small
-kernels, and at the batches SPLID and HER step a Push control step spent 0.31 ms in ``factor_m`` and 0.16 ms in
-``euler`` (16 envs, one H100; BENCHMARKS.md, "Time budget per stage"), launches more than arithmetic. Here each
+kernels: a Push control step at 16 envs spent 0.30 ms in ``factor_m``, 0.16 ms in ``euler`` and 0.10 ms in
+``fwd_acceleration``'s solve (one H100; BENCHMARKS.md, "Time budget per stage"). Here each
 factor and each solve is one kernel, its rows picked with masks as Triton needs (the masked form of
 ``envs/fused_solver.py``), on the matrix padded to 16 x 16 with the identity. The arithmetic is small_cholesky's
 (MJX's upper factor, MuJoCo's pivot floor), summed in another order: equal to float rounding.
