@@ -63,21 +63,26 @@ def with_counted_jit(learner, compiler_options=None):
     return learner
 
 
-def triton_calls_in_step(env: GoalEnv, monkeypatch, batch: tuple[int, ...] = (4,)) -> tuple[int, int]:
-    """How many Triton kernel calls ``env``'s step, vmapped over each axis of ``batch`` (envs last), holds as
-    traced on this CPU and as traced for, and lowered for, a GPU (Pallas's Triton lowering needs no device)."""
+def _triton_calls(env: GoalEnv, batch: tuple[int, ...], gpu: bool) -> int:
+    """Triton kernel calls in ``env``'s step vmapped over each axis of ``batch`` (envs last), traced and lowered
+    for this CPU or for a GPU (Pallas's Triton lowering needs no device; the caller sets the backend)."""
     state = jax.eval_shape(jax.vmap(env.reset), jax.random.split(jax.random.PRNGKey(0), batch[-1]))
     state = jax.tree.map(lambda x: jax.ShapeDtypeStruct(batch[:-1] + x.shape, x.dtype), state)
     actions = jax.ShapeDtypeStruct((*batch, env.action_size), jnp.float32)
+    step = env.step
+    for _ in batch:
+        step = jax.vmap(step)
+    traced = jax.jit(lambda s, a: step(s, a)).trace(state, actions)  # a new function: jit caches traces by function
+    return traced.lower(**({"lowering_platforms": ("cuda",)} if gpu else {})).as_text().count("xla.gpu.triton")
 
-    def batched():  # a new function each time: jit's trace cache would hand the GPU the CPU's trace
-        step = env.step
-        for _ in batch:
-            step = jax.vmap(step)
-        return jax.jit(lambda s, a: step(s, a))
 
-    cpu = batched().trace(state, actions).lower().as_text()
+def triton_calls_for_gpu(env: GoalEnv, monkeypatch, batch: tuple[int, ...] = (4,)) -> int:
+    """How many Triton kernel calls ``env``'s batched step holds as traced for, and lowered for, a GPU."""
     with monkeypatch.context() as patched:
         patched.setattr(jax, "default_backend", lambda: "gpu")
-        gpu = batched().trace(state, actions).lower(lowering_platforms=("cuda",))
-    return cpu.count("xla.gpu.triton"), gpu.as_text().count("xla.gpu.triton")
+        return _triton_calls(env, batch, gpu=True)
+
+
+def triton_calls_in_step(env: GoalEnv, monkeypatch, batch: tuple[int, ...] = (4,)) -> tuple[int, int]:
+    """How many Triton kernel calls ``env``'s batched step holds as traced on this CPU and as traced for a GPU."""
+    return _triton_calls(env, batch, gpu=False), triton_calls_for_gpu(env, monkeypatch, batch)

@@ -33,7 +33,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs import fused_cholesky, fused_collision, fused_solver, small_cholesky, solver_loops
+from envs import fused_cholesky, fused_collision, fused_constraint, fused_solver, small_cholesky, solver_loops
 from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
 from envs.fetch import models
 from splid_jax.common.errors import check, check_integer
@@ -124,12 +124,15 @@ class _FetchTask(GoalEnv):
     # Pallas kernel on a GPU (fused; on a GPU only, MJX's loops on a CPU: gpu-fused; envs/fused_solver.py):
     # equal to float rounding
     solver_loops: str = experimental("gpu-search", numerics_only=True)
-    # the most envs in one batch that the solve and Cholesky kernels take, XLA's batched code above (0: any
-    # batch): one env per program fills a GPU worse than batched operations at thousands (envs/kernel_batch.py)
+    # the most envs in one batch that the solve, Cholesky and constraint-row kernels take, XLA's batched code above
+    # (0: any batch): one env per program fills a GPU worse than batched operations at thousands (kernel_batch.py)
     kernel_envs: int = experimental(0, numerics_only=True)
     # plane-box and box-box contacts as MJX computes them, or as one program per pair, a Pallas kernel on a GPU
     # (fused; on a GPU only: gpu-fused; envs/fused_collision.py): the same contacts up to MJX's float ties
     collision: str = experimental("mjx", numerics_only=True)
+    # the contacts' constraint rows as MJX makes them, or as one program per env, a Pallas kernel on a GPU (fused;
+    # on a GPU only: gpu-fused; envs/fused_constraint.py): equal to float rounding
+    constraint: str = experimental("mjx", numerics_only=True)
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
     # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
@@ -179,6 +182,8 @@ class _FetchTask(GoalEnv):
         check_integer(f"{n}.kernel_envs", self.kernel_envs, 0)
         ok = self.collision in COLLISION
         check(ok, f"{n}.collision", self.collision, "one of " + ", ".join(COLLISION))
+        ok = self.constraint in COLLISION
+        check(ok, f"{n}.constraint", self.constraint, "one of " + ", ".join(COLLISION))
         grasp_range = "in [0, 1]" if not self.block_gripper else "0 (the fingers are locked on this task)"
         ok = 0 <= self.grasped_starts <= 1 and (self.grasped_starts == 0 or not self.block_gripper)
         check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
@@ -363,7 +368,7 @@ class _FetchTask(GoalEnv):
     def kernel_fallback(self, error: BaseException) -> str | None:
         """The options that leave the physics' Triton kernels out, when a GPU's compiler failed on one (its error
         names Triton)."""
-        own = (("solver_loops", "gpu-search"), ("collision", "mjx"), ("cholesky", "unrolled"))
+        own = (("solver_loops", "gpu-search"), ("collision", "mjx"), ("constraint", "mjx"), ("cholesky", "unrolled"))
         options = [f"{name}={mjx_own}" for name, mjx_own in own if getattr(self, name) in KERNELS]
         if not options or "triton" not in str(error).lower():
             return None
@@ -385,6 +390,9 @@ class _FetchTask(GoalEnv):
                 runs_as_kernel(self.solver_loops, backend), kernel=backend == "gpu", max_envs=self.kernel_envs
             ),
             fused_collision.fused_in_mjx(runs_as_kernel(self.collision, backend), kernel=backend == "gpu"),
+            fused_constraint.fused_in_mjx(
+                runs_as_kernel(self.constraint, backend), kernel=backend == "gpu", max_envs=self.kernel_envs
+            ),
         ):
             yield
 

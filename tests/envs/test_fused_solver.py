@@ -8,13 +8,11 @@ import functools
 import jax
 import jax.numpy as jnp
 import numpy as np
-import pytest
 from mujoco.mjx._src import solver as mjx_solver
 
 import envs
 from envs import fused_solver
 from envs.fetch.tasks import runs_as_kernel
-from splid_jax.common.errors import InvalidConfig
 from tests.helpers import triton_calls_in_step
 
 
@@ -120,34 +118,6 @@ def test_push_default_solves_through_the_kernel_on_a_gpu_only(monkeypatch):
     assert triton_calls_in_step(env, monkeypatch) == (0, 1)
     assert [runs_as_kernel("gpu-fused", b) for b in ("gpu", "cpu")] == [True, False]
     assert runs_as_kernel("fused", "cpu") and not runs_as_kernel("gpu-search", "gpu")
-
-
-def test_solve_kernel_takes_batches_up_to_its_limit_and_mjx_solves_larger_ones(monkeypatch):
-    # one env per program loses to MJX's batched solve at thousands of envs; a sweep's members (the outer
-    # axis) do not count against the limit, the envs of one step (the inner axis) do
-    env = envs.make("push", substeps=1, collision="mjx", kernel_envs=8)
-    assert triton_calls_in_step(env, monkeypatch, (8,)) == (0, 1)
-    assert triton_calls_in_step(env, monkeypatch, (9,)) == (0, 0)
-    assert triton_calls_in_step(env, monkeypatch, (3, 8)) == (0, 1)
-    assert triton_calls_in_step(env, monkeypatch, (2, 9)) == (0, 0)
-    with pytest.raises(InvalidConfig, match="kernel_envs"):
-        envs.make("push", kernel_envs=-1)
-
-
-def test_a_batch_above_the_kernels_limit_is_mjxs_own_solve():
-    from mujoco import mjx
-
-    env = envs.make("push")
-    model = env.mjx_model
-    data = jax.jit(mjx.forward)(model, mjx.make_data(model).replace(qpos=jnp.asarray(env.mj_model.qpos0)))
-    warm = data.qacc + 0.1 * jax.random.normal(jax.random.PRNGKey(4), (5, model.nv))
-
-    def solved(solve):  # only the warm start batched: the other fields reach the solve unbatched
-        return jax.jit(jax.vmap(lambda w: solve(data.replace(qacc_warmstart=w)).qacc))(warm)
-
-    mjxs = solved(lambda d: mjx_solver.solve(model, d))
-    assert float(jnp.abs(data._impl.efc_J).max()) > 0  # the cube and the fingers rest on the table
-    np.testing.assert_array_equal(solved(lambda d: fused_solver.solve(model, d, True, max_envs=4)), mjxs)
 
 
 def test_a_kernel_compile_failure_names_the_options_that_avoid_it():

@@ -1,0 +1,53 @@
+"""The kernels' batch limit (``kernel_envs``): a kernel where the innermost vmap holds at most that many envs, XLA's
+batched code above it, whatever vmaps enclose it; above it the arithmetic is MJX's own, bit for bit."""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from mujoco import mjx
+from mujoco.mjx._src import solver as mjx_solver
+
+import envs
+from envs import fused_solver, kernel_batch
+from splid_jax.common.errors import InvalidConfig
+from tests.helpers import triton_calls_for_gpu
+
+
+def test_kernels_take_batches_up_to_the_limit_and_xla_larger_ones(monkeypatch):
+    # one env per program loses to batched operations at thousands of envs; a sweep's members (the outer axis)
+    # do not count against the limit, the envs of one step (the inner axis) do. The contact kernels (2) are
+    # vmapped over their pairs inside the step, so the limit leaves them.
+    env = envs.make("push", substeps=1, cholesky="gpu-fused", constraint="gpu-fused", kernel_envs=8)
+    counts = [triton_calls_for_gpu(env, monkeypatch, b) for b in ((9,), (3, 8), (2, 9))]
+    assert counts == [2, 8, 2]  # with the solve, two factors, two solves and the rows at 8 envs
+    with pytest.raises(InvalidConfig, match="kernel_envs"):
+        envs.make("push", kernel_envs=-1)
+
+
+def test_a_batch_above_the_limit_is_mjxs_own_solve():
+    env = envs.make("push")
+    model = env.mjx_model
+    data = jax.jit(mjx.forward)(model, mjx.make_data(model).replace(qpos=jnp.asarray(env.mj_model.qpos0)))
+    warm = data.qacc + 0.1 * jax.random.normal(jax.random.PRNGKey(4), (5, model.nv))
+
+    def solved(solve):  # only the warm start batched: the other fields reach the solve unbatched
+        return jax.jit(jax.vmap(lambda w: solve(data.replace(qacc_warmstart=w)).qacc))(warm)
+
+    mjxs = solved(lambda d: mjx_solver.solve(model, d))
+    assert float(jnp.abs(data._impl.efc_J).max()) > 0  # the cube and the fingers rest on the table
+    np.testing.assert_array_equal(solved(lambda d: fused_solver.solve(model, d, True, max_envs=4)), mjxs)
+
+
+def test_no_limit_keeps_the_kernel_function_itself():
+    def kernel(x):
+        return x + 1
+
+    assert kernel_batch.by_batch(kernel, lambda x: x, 0) is kernel
+    limited = kernel_batch.by_batch(kernel, lambda x: x - 1, 2)
+    assert float(limited(jnp.float32(1.0))) == 2.0  # unbatched: the kernel
+    np.testing.assert_array_equal(jax.vmap(limited)(jnp.ones(2)), [2.0, 2.0])
+    np.testing.assert_array_equal(jax.vmap(limited)(jnp.ones(3)), [0.0, 0.0, 0.0])
+    np.testing.assert_array_equal(jax.vmap(jax.vmap(limited))(jnp.ones((3, 2))), np.full((3, 2), 2.0))
