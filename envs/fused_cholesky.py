@@ -15,11 +15,10 @@ import contextlib
 
 import jax
 import jax.numpy as jnp
-import jax.scipy.linalg as jsl
 
 from envs import kernel_batch, small_cholesky
 from envs.fused_solver import at_mask, col_at, pow2, row_at
-from envs.small_cholesky import MIN_PIVOT, TRACE_LOCK
+from envs.small_cholesky import MIN_PIVOT
 
 
 def upper_factor(a, size: int):
@@ -110,10 +109,5 @@ def fused_in_mjx(enabled: bool = True, max_envs: int = 0, interpret: bool = Fals
             return small_cholesky.cho_solve(c_and_lower, b, overwrite_b, check_finite)
         return solve(c.T if lower else c, b)
 
-    with TRACE_LOCK:
-        saved = (jsl.cho_factor, jsl.cho_solve)
-        jsl.cho_factor, jsl.cho_solve = cho_factor, cho_solve
-        try:
-            yield
-        finally:
-            jsl.cho_factor, jsl.cho_solve = saved
+    with small_cholesky.linalg_swapped(cho_factor, cho_solve):
+        yield

@@ -99,14 +99,21 @@ def cho_solve(c_and_lower, b, overwrite_b: bool = False, check_finite: bool = Tr
 def unrolled_in_mjx(enabled: bool = True):
     """Within the block, ``jax.scipy.linalg.cho_factor`` / ``cho_solve`` are the unrolled ones above.
 
-    Meant around the trace of MJX calls (``mjx.step`` inside a jitted function). The (re-entrant)
-    lock keeps two threads from tracing through it at once."""
+    Meant around the trace of MJX calls (``mjx.step`` inside a jitted function)."""
     if not enabled:
         yield
         return
+    with linalg_swapped(cho_factor, cho_solve):
+        yield
+
+
+@contextlib.contextmanager
+def linalg_swapped(factor, solve):
+    """Within the block, ``jax.scipy.linalg.cho_factor`` / ``cho_solve`` are ``factor`` / ``solve``; the
+    (re-entrant) lock keeps two threads from tracing through a swap at once."""
     with TRACE_LOCK:
         saved = (jsl.cho_factor, jsl.cho_solve)
-        jsl.cho_factor, jsl.cho_solve = cho_factor, cho_solve
+        jsl.cho_factor, jsl.cho_solve = factor, solve
         try:
             yield
         finally:
