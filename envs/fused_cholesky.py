@@ -5,8 +5,9 @@ with it twice; written out element by element (``envs/small_cholesky.py``) XLA m
 kernels: a Push control step at 16 envs spent 0.30 ms in ``factor_m``, 0.16 ms in ``euler`` and 0.10 ms in
 ``fwd_acceleration``'s solve (one H100; BENCHMARKS.md, "Time budget per stage"). Here each
 factor and each solve is one kernel, its rows picked with masks as Triton needs (the masked form of
-``envs/fused_solver.py``), on the matrix padded to 16 x 16 with the identity. The arithmetic is small_cholesky's
-(MJX's upper factor, MuJoCo's pivot floor), summed in another order: equal to float rounding.
+``envs/fused_solver.py``), on the matrix padded to 16 x 16 with zeros (only its first n rows and columns are
+computed). The arithmetic is small_cholesky's (the upper factor MJX keeps, MuJoCo's pivot floor), summed in
+another order: equal to float rounding.
 """
 
 from __future__ import annotations

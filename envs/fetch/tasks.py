@@ -46,8 +46,8 @@ CHOLESKY = ("unrolled", "library", "gpu-fused")  # small_cholesky.py, jax.scipy.
 # MJX's solver loops, both written out, the line search alone written out, each of the last two on a GPU only, and
 # the whole solve as one program per env (envs/fused_solver.py), always or on a GPU only
 SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused", "gpu-fused")
-# plane-box and box-box contacts: MJX's, or envs/fused_collision.py always or on a GPU only
-COLLISION = ("mjx", "fused", "gpu-fused")
+# contacts (plane-box and box-box) and their constraint rows: MJX's, or envs/fused_*.py's always or on a GPU only
+MJX_OR_FUSED = ("mjx", "fused", "gpu-fused")
 KERNELS = ("fused", "gpu-fused")  # the choices above that run a part of the physics as a Pallas kernel
 
 
@@ -180,10 +180,9 @@ class _FetchTask(GoalEnv):
         ok = self.solver_loops in SOLVER_LOOPS
         check(ok, f"{n}.solver_loops", self.solver_loops, "one of " + ", ".join(SOLVER_LOOPS))
         check_integer(f"{n}.kernel_envs", self.kernel_envs, 0)
-        ok = self.collision in COLLISION
-        check(ok, f"{n}.collision", self.collision, "one of " + ", ".join(COLLISION))
-        ok = self.constraint in COLLISION
-        check(ok, f"{n}.constraint", self.constraint, "one of " + ", ".join(COLLISION))
+        for name in ("collision", "constraint"):
+            value = getattr(self, name)
+            check(value in MJX_OR_FUSED, f"{n}.{name}", value, "one of " + ", ".join(MJX_OR_FUSED))
         grasp_range = "in [0, 1]" if not self.block_gripper else "0 (the fingers are locked on this task)"
         ok = 0 <= self.grasped_starts <= 1 and (self.grasped_starts == 0 or not self.block_gripper)
         check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
@@ -378,7 +377,8 @@ class _FetchTask(GoalEnv):
     @contextlib.contextmanager
     def solver_in_mjx(self):
         """Within the block (a trace of MJX calls), MJX factors, solves and collides boxes as this task's
-        ``cholesky``, ``solver_loops`` and ``collision`` choose, on the backend being traced for."""
+        ``cholesky``, ``solver_loops``, ``collision`` and ``constraint`` choose (the kernels up to ``kernel_envs``
+        envs), on the backend being traced for."""
         backend = jax.default_backend()
         newton, line_search = solver_loops.writes_out(self.solver_loops, backend)
         cholesky_kernel = runs_as_kernel(self.cholesky, backend)
