@@ -26,6 +26,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from envs import kernel_batch
 from envs.base import data_with
 from envs.small_cholesky import TRACE_LOCK
 
@@ -432,11 +433,22 @@ def _plane_box_group(m, d, key, geom, kernel: bool):
     return dist.reshape(-1), pos.reshape(-1, 3), frame.reshape(-1, 3, 3)
 
 
+def _limited(group, mjx_group, max_envs: int):
+    """``group`` where a step's envs are at most ``max_envs``, MJX's function for the pairs above
+    (``envs/kernel_batch.py``)."""
+
+    def collide(m, d, key, geom):
+        own = lambda x, g: group(m, x, key, g)  # noqa: E731
+        return kernel_batch.by_batch(own, lambda x, g: mjx_group(m, x, key, g), max_envs)(d, geom)
+
+    return collide
+
+
 @contextlib.contextmanager
-def fused_in_mjx(enabled: bool = True, kernel: bool = False):
+def fused_in_mjx(enabled: bool = True, kernel: bool = False, max_envs: int = 0):
     """Within the block, MJX's collision driver collides planes with boxes and boxes with boxes through
-    ``plane_box`` and ``box_box`` (as Pallas kernels if ``kernel``). The driver looks its functions up when its code
-    runs, which under ``jit`` is trace time only."""
+    ``plane_box`` and ``box_box`` (as Pallas kernels if ``kernel``, at batches up to ``max_envs`` if not 0). The
+    driver looks its functions up when its code runs, which under ``jit`` is trace time only."""
     if not enabled:
         yield
         return
@@ -448,7 +460,8 @@ def fused_in_mjx(enabled: bool = True, kernel: bool = False):
     with TRACE_LOCK:
         saved = {key: table[key] for key in groups}
         for key, group in groups.items():
-            table[key] = functools.partial(group, kernel=kernel)
+            fn = functools.partial(group, kernel=kernel)
+            table[key] = _limited(fn, saved[key], max_envs) if kernel and max_envs else fn
             table[key].ncon = 4
         try:
             yield

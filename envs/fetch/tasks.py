@@ -124,8 +124,8 @@ class _FetchTask(GoalEnv):
     # Pallas kernel on a GPU (fused; on a GPU only, MJX's loops on a CPU: gpu-fused; envs/fused_solver.py):
     # equal to float rounding
     solver_loops: str = experimental("gpu-search", numerics_only=True)
-    # the most envs in one batch that the solve, Cholesky and constraint-row kernels take, XLA's batched code above
-    # (0: any batch): one env per program fills a GPU worse than batched operations at thousands (kernel_batch.py)
+    # the most envs in one batch that the physics kernels take, MJX's batched code above (0: any batch): one env
+    # per program fills a GPU worse than batched operations at thousands of envs (envs/kernel_batch.py)
     kernel_envs: int = experimental(0, numerics_only=True)
     # plane-box and box-box contacts as MJX computes them, or as one program per pair, a Pallas kernel on a GPU
     # (fused; on a GPU only: gpu-fused; envs/fused_collision.py): the same contacts up to MJX's float ties
@@ -389,7 +389,9 @@ class _FetchTask(GoalEnv):
             fused_solver.fused_in_mjx(
                 runs_as_kernel(self.solver_loops, backend), kernel=backend == "gpu", max_envs=self.kernel_envs
             ),
-            fused_collision.fused_in_mjx(runs_as_kernel(self.collision, backend), kernel=backend == "gpu"),
+            fused_collision.fused_in_mjx(
+                runs_as_kernel(self.collision, backend), kernel=backend == "gpu", max_envs=self.kernel_envs
+            ),
             fused_constraint.fused_in_mjx(
                 runs_as_kernel(self.constraint, backend), kernel=backend == "gpu", max_envs=self.kernel_envs
             ),
