@@ -20,6 +20,7 @@ import contextlib
 import dataclasses
 import functools
 import operator
+import types
 
 import jax
 import jax.numpy as jnp
@@ -49,7 +50,7 @@ class Layout:
     invweight: tuple[float, ...]
     impratio: float
     timestep: float
-    refsafe: bool
+    disableflags: int
 
     @property
     def nefc(self) -> int:
@@ -95,7 +96,7 @@ def layout(m, d) -> Layout | None:
         invweight=tuple(float(x) for x in np.asarray(m.body_invweight0)[:, 0]),
         impratio=float(m.opt.impratio),
         timestep=float(m.opt.timestep),
-        refsafe=not m.opt.disableflags & DisableBit.REFSAFE,
+        disableflags=int(m.opt.disableflags),
     )
 
 
@@ -108,30 +109,6 @@ def contact_table(contact, rows: int | None = None):
     table = jnp.concatenate(cols, axis=1)
     rows = n if rows is None else rows
     return jnp.pad(table, ((0, rows - n), (0, _WIDTH - table.shape[1])))
-
-
-def _kbi(lay: Layout, solref, solimp, pos):
-    """MJX's ``constraint._kbi`` on scalars, with the model's numbers as Python floats (a kernel captures no
-    arrays)."""
-    timeconst, dampratio = solref
-    if lay.refsafe:
-        timeconst = jnp.maximum(timeconst, 2 * lay.timestep)
-    dmin, dmax, width, mid, power = solimp
-    dmin = jnp.clip(dmin, mujoco.mjMINIMP, mujoco.mjMAXIMP)
-    dmax = jnp.clip(dmax, mujoco.mjMINIMP, mujoco.mjMAXIMP)
-    width = jnp.maximum(mujoco.mjMINVAL, width)
-    mid = jnp.clip(mid, mujoco.mjMINIMP, mujoco.mjMAXIMP)
-    power = jnp.maximum(1.0, power)
-    k = 1 / (dmax * dmax * timeconst * timeconst * dampratio * dampratio)
-    b = 2 / (dmax * timeconst)
-    k = jnp.where(solref[0] <= 0, -solref[0] / (dmax * dmax), k)
-    b = jnp.where(solref[1] <= 0, -solref[1] / dmax, b)
-    imp_x = jnp.abs(pos) / width
-    imp_a = (1.0 / jnp.power(mid, power - 1)) * jnp.power(imp_x, power)
-    imp_b = 1 - (1.0 / jnp.power(1 - mid, power - 1)) * jnp.power(1 - imp_x, power)
-    imp = dmin + jnp.where(imp_x < mid, imp_a, imp_b) * (dmax - dmin)
-    imp = jnp.clip(imp, dmin, dmax)
-    return k, b, jnp.where(imp_x > 1.0, dmax, imp)
 
 
 def rows(lay: Layout, table, cdof, com, qvel):
@@ -158,11 +135,14 @@ def rows(lay: Layout, table, cdof, com, qvel):
 
     J = jnp.zeros((nrows, nvp), cdof.dtype)
     D = aref = pos_out = margin_out = jnp.zeros((nrows,), cdof.dtype)
+    # MJX's stiffness, damping and impedance read the model's timestep and flags: here as Python numbers, which a
+    # kernel holds (it captures no arrays)
+    scalars = types.SimpleNamespace(opt=types.SimpleNamespace(timestep=lay.timestep, disableflags=lay.disableflags))
     r = 0
     width = jnp.arange(_WIDTH)
     for c, dim in enumerate(lay.dims):
         rec = row_at(table, c)
-        f = [at_mask(rec, width == k) for k in range(_WIDTH)]
+        f = [at_mask(rec, width == k) for k in range(_GEOM + 2)]
         frame = [f[_FRAME + 3 * i : _FRAME + 3 * i + 3] for i in range(3)]
         point = f[_POS : _POS + 3]
         body1 = _body(lay, f[_GEOM])
@@ -177,7 +157,7 @@ def rows(lay: Layout, table, cdof, com, qvel):
         active = pos < 0
         inv = pick(lay.invweight, body1) + pick(lay.invweight, body2)
         inv = (inv + fri[0] * fri[0] * inv) * 2 * fri[0] * fri[0] / lay.impratio
-        k_, b_, imp = _kbi(lay, f[_SOLREF : _SOLREF + 2], f[_SOLIMP : _SOLIMP + 5], pos)
+        k_, b_, imp = mjx_constraint._kbi(scalars, f[_SOLREF : _SOLREF + 2], f[_SOLIMP : _SOLIMP + 5], pos)
         reg = jnp.maximum(inv * (1 - imp) / imp, mujoco.mjMINVAL)
         pos_aref = jnp.where(active, pos, 0.0)
         for e in range(dim - 1):
