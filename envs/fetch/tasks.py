@@ -52,9 +52,9 @@ KERNELS = ("fused", "gpu-fused")  # the choices above that run a part of the phy
 
 
 def runs_as_kernel(choice: str, backend: str) -> bool:
-    """Whether a ``solver_loops`` or ``collision`` choice runs its part as envs/fused_*.py's function on ``backend``:
-    ``fused`` always, ``gpu-fused`` on a GPU only (on a CPU their functions run as XLA code, where MJX's solver
-    loops are faster)."""
+    """Whether a ``solver_loops``, ``collision``, ``constraint`` or ``cholesky`` choice runs its part as
+    envs/fused_*.py's function on ``backend``: ``fused`` always, ``gpu-fused`` on a GPU only (on a CPU their
+    functions run as XLA code, where MJX's own are as fast or faster)."""
     return choice == "fused" or (choice == "gpu-fused" and backend == "gpu")
 
 
