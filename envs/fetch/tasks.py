@@ -53,8 +53,8 @@ KERNELS = ("fused", "gpu-fused")  # the choices above that run a part of the phy
 
 def runs_as_kernel(choice: str, backend: str) -> bool:
     """Whether a ``solver_loops``, ``collision``, ``constraint`` or ``cholesky`` choice runs its part as
-    envs/fused_*.py's function on ``backend``: ``fused`` always, ``gpu-fused`` on a GPU only (on a CPU their
-    functions run as XLA code, where MJX's own are as fast or faster)."""
+    envs/fused_*.py's function on ``backend``: ``fused`` always, ``gpu-fused`` on a GPU only (on a CPU the
+    functions run as XLA code: the solve and the rows slower than MJX's, and MJX's keeps CPU runs as they were)."""
     return choice == "fused" or (choice == "gpu-fused" and backend == "gpu")
 
 
