@@ -452,6 +452,10 @@ class Slide(_FetchTask):
     obj_range: float = 0.1
     target_range: float = 0.3
     iterations: int = 10  # 4 let a resting low-friction puck creep in float32 (up to 10 cm in 50 steps)
+    # the solve as a kernel on a GPU for a step's envs, MJX's batched solve for SELECT's thousands of replayed
+    # rows, where the kernel fills the GPU worse: the command compiled faster so (BENCHMARKS.md)
+    solver_loops: str = experimental("gpu-fused", numerics_only=True)
+    kernel_envs: int = experimental(2048, numerics_only=True)
     kind = "slide"
     target_offset = (0.4, 0.0, 0.0)
 
@@ -462,6 +466,11 @@ class PickAndPlace(_FetchTask):
 
     # the finger joints' response to their actuators (models.FINGER_DRIVES): the reference's, or the fast one
     finger_drive: str = experimental("reference")
+    # the solve and the box contacts as kernels on a GPU for a step's envs, MJX's batched code for SELECT's
+    # thousands of replayed rows, where the kernels fill the GPU worse: the command ran faster so (BENCHMARKS.md)
+    solver_loops: str = experimental("gpu-fused", numerics_only=True)
+    collision: str = experimental("gpu-fused", numerics_only=True)
+    kernel_envs: int = experimental(2048, numerics_only=True)
     kind = "pick_and_place"
     block_gripper = False
     target_in_the_air = True
