@@ -33,7 +33,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs import fused_cholesky, fused_collision, fused_constraint, fused_solver, small_cholesky, solver_loops
+from envs import fused_collision, fused_solver, small_cholesky, solver_loops
 from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
 from envs.fetch import models
 from splid_jax.common.errors import check, check_integer
@@ -42,19 +42,19 @@ MIN_OBJECT_DISTANCE = 0.1  # the object starts at least this far from the grippe
 _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4) ** 64 ~ 2e-7
 GOAL_LIFT_MAX = 0.45
 GRASP_ABOVE_SITE = 0.01  # a grasped cube's centre above the grip site: inside the fingers' 6 cm height
-CHOLESKY = ("unrolled", "library", "gpu-fused")  # small_cholesky.py, jax.scipy.linalg's, fused_cholesky.py on a GPU
+CHOLESKY = ("unrolled", "library")  # small_cholesky.py's, jax.scipy.linalg's
 # MJX's solver loops, both written out, the line search alone written out, each of the last two on a GPU only, and
 # the whole solve as one program per env (envs/fused_solver.py), always or on a GPU only
 SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused", "gpu-fused")
-# contacts (plane-box and box-box) and their constraint rows: MJX's, or envs/fused_*.py's always or on a GPU only
+# contacts (plane-box and box-box): MJX's, or envs/fused_collision.py's always or on a GPU only
 MJX_OR_FUSED = ("mjx", "fused", "gpu-fused")
 KERNELS = ("fused", "gpu-fused")  # the choices above that run a part of the physics as a Pallas kernel
 
 
 def runs_as_kernel(choice: str, backend: str) -> bool:
-    """Whether a ``solver_loops``, ``collision``, ``constraint`` or ``cholesky`` choice runs its part as
-    envs/fused_*.py's function on ``backend``: ``fused`` always, ``gpu-fused`` on a GPU only (on a CPU the
-    functions run as XLA code: the solve and the rows slower than MJX's, and MJX's keeps CPU runs as they were)."""
+    """Whether a ``solver_loops`` or ``collision`` choice runs its part as envs/fused_*.py's function on
+    ``backend``: ``fused`` always, ``gpu-fused`` on a GPU only (on a CPU the functions run as XLA code: the solve
+    slower than MJX's, and MJX's keeps CPU runs as they were)."""
     return choice == "fused" or (choice == "gpu-fused" and backend == "gpu")
 
 
@@ -116,8 +116,7 @@ class _FetchTask(GoalEnv):
     table: str = experimental("plane")
     # the closed finger block's collision shape (Push: pads, box or capsule, see models.py)
     finger: str = experimental("box")
-    # how MJX factors its small dense systems: written out (envs/small_cholesky.py), "library", or one Pallas
-    # kernel per factor and per solve on a GPU, written out on a CPU (gpu-fused; envs/fused_cholesky.py)
+    # how MJX factors its small dense systems: written out (envs/small_cholesky.py) or "library"
     cholesky: str = experimental("unrolled")
     # MJX's Newton solver as its loops, written out (unrolled), its line search alone written out (search),
     # or either on a GPU only (auto, gpu-search; envs/solver_loops.py), or the whole solve one program per env, a
@@ -130,9 +129,6 @@ class _FetchTask(GoalEnv):
     # plane-box and box-box contacts as MJX computes them, or as one program per pair, a Pallas kernel on a GPU
     # (fused; on a GPU only: gpu-fused; envs/fused_collision.py): the same contacts up to MJX's float ties
     collision: str = experimental("mjx", numerics_only=True)
-    # the contacts' constraint rows as MJX makes them, or as one program per env, a Pallas kernel on a GPU (fused;
-    # on a GPU only: gpu-fused; envs/fused_constraint.py): equal to float rounding
-    constraint: str = experimental("mjx", numerics_only=True)
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
     # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
@@ -180,9 +176,8 @@ class _FetchTask(GoalEnv):
         ok = self.solver_loops in SOLVER_LOOPS
         check(ok, f"{n}.solver_loops", self.solver_loops, "one of " + ", ".join(SOLVER_LOOPS))
         check_integer(f"{n}.kernel_envs", self.kernel_envs, 0)
-        for name in ("collision", "constraint"):
-            value = getattr(self, name)
-            check(value in MJX_OR_FUSED, f"{n}.{name}", value, "one of " + ", ".join(MJX_OR_FUSED))
+        ok = self.collision in MJX_OR_FUSED
+        check(ok, f"{n}.collision", self.collision, "one of " + ", ".join(MJX_OR_FUSED))
         grasp_range = "in [0, 1]" if not self.block_gripper else "0 (the fingers are locked on this task)"
         ok = 0 <= self.grasped_starts <= 1 and (self.grasped_starts == 0 or not self.block_gripper)
         check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
@@ -367,7 +362,7 @@ class _FetchTask(GoalEnv):
     def kernel_fallback(self, error: BaseException) -> str | None:
         """The options that leave the physics' Triton kernels out, when a GPU's compiler failed on one (its error
         names Triton)."""
-        own = (("solver_loops", "gpu-search"), ("collision", "mjx"), ("constraint", "mjx"), ("cholesky", "unrolled"))
+        own = (("solver_loops", "gpu-search"), ("collision", "mjx"))
         options = [f"{name}={mjx_own}" for name, mjx_own in own if getattr(self, name) in KERNELS]
         if not options or "triton" not in str(error).lower():
             return None
@@ -377,23 +372,18 @@ class _FetchTask(GoalEnv):
     @contextlib.contextmanager
     def solver_in_mjx(self):
         """Within the block (a trace of MJX calls), MJX factors, solves and collides boxes as this task's
-        ``cholesky``, ``solver_loops``, ``collision`` and ``constraint`` choose (the kernels up to ``kernel_envs``
-        envs), on the backend being traced for."""
+        ``cholesky``, ``solver_loops`` and ``collision`` choose (the kernels up to ``kernel_envs`` envs), on the
+        backend being traced for."""
         backend = jax.default_backend()
         newton, line_search = solver_loops.writes_out(self.solver_loops, backend)
-        cholesky_kernel = runs_as_kernel(self.cholesky, backend)
         with (
-            small_cholesky.unrolled_in_mjx(self.cholesky in ("unrolled", "gpu-fused") and not cholesky_kernel),
-            fused_cholesky.fused_in_mjx(cholesky_kernel, max_envs=self.kernel_envs),
+            small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"),
             solver_loops.unrolled_in_mjx(self.iterations, newton, line_search),
             fused_solver.fused_in_mjx(
                 runs_as_kernel(self.solver_loops, backend), kernel=backend == "gpu", max_envs=self.kernel_envs
             ),
             fused_collision.fused_in_mjx(
                 runs_as_kernel(self.collision, backend), kernel=backend == "gpu", max_envs=self.kernel_envs
-            ),
-            fused_constraint.fused_in_mjx(
-                runs_as_kernel(self.constraint, backend), kernel=backend == "gpu", max_envs=self.kernel_envs
             ),
         ):
             yield

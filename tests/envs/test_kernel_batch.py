@@ -19,9 +19,9 @@ from tests.helpers import triton_calls_for_gpu
 def test_kernels_take_batches_up_to_the_limit_and_xla_larger_ones(monkeypatch):
     # one env per program loses to batched operations at thousands of envs; a sweep's members (the outer axis)
     # do not count against the limit, the envs of one step (the inner axis) do
-    env = envs.make("push", substeps=1, cholesky="gpu-fused", constraint="gpu-fused", kernel_envs=8)
+    env = envs.make("push", substeps=1, kernel_envs=8)
     counts = [triton_calls_for_gpu(env, monkeypatch, b) for b in ((9,), (3, 8), (2, 9))]
-    assert counts == [0, 8, 0]  # at 8 envs two contact groups, the rows, two factors, two solves and the solve
+    assert counts == [0, 3, 0]  # at 8 envs Push's two contact groups and the solve
     with pytest.raises(InvalidConfig, match="kernel_envs"):
         envs.make("push", kernel_envs=-1)
 
