@@ -4,7 +4,9 @@ Python runs only between compiled chunks: it logs, writes metrics.jsonl (one sch
 algorithm, run and sweep), evaluates through the chunk, checkpoints with orbax, stops on NaN, and
 resumes bit for bit. The chunk is traced, checked against the device's memory and compiled once
 (``jax.jit(...).trace(...).lower().compile()``) before any state is allocated, so a run that cannot
-fit is refused with its estimate and the compile is timed apart from the first chunk.
+fit is refused with its estimate and the compile is timed apart from the first chunk. The initial
+state is built while XLA compiles, and on one process each checkpoint is written while the next chunk
+runs (Push's state writes in 0.2 to 0.3 s on a GPU host, five HER seeds' in about 2 s on a 2-core CPU).
 
 A signal stops the run at any moment with its newest whole state checkpointed (``signals``); the run
 directory's files are ``run_files``', the memory check ``memory``'s, a sweep split over devices
@@ -192,6 +194,7 @@ class _Loop:
         self.device = place.first
         self.saved_at: int | None = None
         self.groups: Groups | None = None
+        self.writing: Callable[[], None] | None = None  # a checkpoint write running beside the next chunk
 
     def show(self, text: str) -> None:
         progress.show(text, self.quiet)
@@ -271,6 +274,8 @@ class _Loop:
                   + (f" members={len(self.lanes)}" if self.stacked else ""))  # fmt: skip
         self.show(f"compiling the training program ({compile_hint(self.env)}; "
                   "less when the compile cache holds it)...")  # fmt: skip
+        first = lambda: initial_state(algo.init, keys, self.stacked, self.device.platform == "cpu")  # noqa: E731
+        initial = None if resume else self.signals.begin(first)  # built on the device while XLA compiles the chunk
         t0 = time.perf_counter()
         try:
             compiled = self.signals.wait(lambda: traced.lower().compile())
@@ -292,8 +297,7 @@ class _Loop:
         if resume:
             state, select_steps, wall_before = self.restore(like)
         else:
-            first = lambda: initial_state(algo.init, keys, self.stacked, self.device.platform == "cpu")  # noqa: E731
-            state = _canonical(self.signals.wait(first), sharding)
+            state = _canonical(self.signals.wait(initial), sharding)
             state = state if groups is None else groups.split(state)
             select_steps, wall_before = [0] * len(self.lanes), 0.0
             for lane in self.lanes if self.writes else ():
@@ -338,6 +342,13 @@ class _Loop:
         else:
             state = _canonical(state, self.place.state_sharding())
         return state, [int(s) for s in meta["select_steps"]], float(meta["wall_s"])
+
+    def wait_for_write(self) -> None:
+        """The checkpoint write left running beside a chunk, finished (or its error raised). A plain join,
+        which a signal does not cut short: the write's own grace (``Signals.finish``) bounds it."""
+        writing, self.writing = self.writing, None
+        if writing is not None:
+            writing()
 
     def save(self, state, iteration: int, select_steps: list[int], wall_s: float) -> None:
         if self.saved_at == iteration:
@@ -413,17 +424,28 @@ class _Loop:
                     self.show((progress.header(last[0]) + "\n" if chunks == 1 else "") + progress.line(last[0],
                               cfg.iterations))  # fmt: skip
                 if iteration == cfg.iterations or (cfg.checkpoint_every and chunks % cfg.checkpoint_every == 0):
-                    self.save(state, iteration, select_steps, wall())
+                    self.wait_for_write()
+                    if iteration < cfg.iterations and not self.signals.shared:  # written beside the next chunk
+                        args = (state, iteration, select_steps, wall())
+                        self.writing = self.signals.begin(lambda a=args: self.save(*a))
+                    else:
+                        self.save(state, iteration, select_steps, wall())
                 self.signals.agree()
         except SaveAbandoned:
             raise
         except Interrupted as stop:
+            self.wait_for_write()
             self.save(state, iteration, select_steps, wall())
             name = signal.Signals(stop.signum).name
             self.show(f"interrupted ({name}): saved iteration {iteration} to {cfg.run_dir}; resume with --resume")
             stop.reported = True
             raise
         except RunStopped:
+            self.wait_for_write()
             self.save(state, iteration, select_steps, wall())
+            raise
+        except Exception:  # the chunk's own error is the one to report; a write under way still ends whole
+            with contextlib.suppress(Exception):
+                self.wait_for_write()
             raise
         return last

@@ -93,6 +93,17 @@ class Signals:
                 late_after = None
         return _result(box)
 
+    def begin(self, fn: Callable[[], Any]) -> Callable[[], Any]:
+        """``fn()`` started now in a daemon thread, beside whatever the caller waits on next; the returned
+        function, given to ``wait``, collects its result (or raises its error)."""
+        thread, box = _started(fn)
+
+        def joined() -> Any:
+            thread.join()
+            return _result(box)
+
+        return joined
+
     def finish(self, fn: Callable[[], Any], grace: float = GRACE_S) -> Any:
         """``fn()`` (a checkpoint save) in a daemon thread, which a first signal does not cut short: a
         signal before or during it leaves it ``grace`` seconds, a further signal none. Past that it

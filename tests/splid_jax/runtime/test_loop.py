@@ -268,6 +268,42 @@ def test_nan_stops_the_run_and_keeps_the_last_good_state(tmp_path):
     assert [r["iteration"] for r in records(cfg.run_dir)] == [2]
 
 
+def test_a_checkpoint_is_written_while_the_next_chunk_runs(tmp_path, monkeypatch):
+    cfg = config(tmp_path, checkpoint_every=1)
+    next_chunk_ended, waited = threading.Event(), []
+    save = checkpoint.save
+
+    def slow_save(run_dir, step, *a, **kw):  # the write of iteration 2 ends only once iteration 4 is recorded
+        if step == 2:
+            waited.append(next_chunk_ended.wait(30))
+        return save(run_dir, step, *a, **kw)
+
+    monkeypatch.setattr(checkpoint, "save", slow_save)
+    on_record = lambda run_dir, rec: rec["iteration"] == 4 and next_chunk_ended.set()  # noqa: E731
+    loop.run(cfg, ENV, algo=Toy(ENV, cfg), quiet=True, on_record=on_record)
+    assert waited == [True]
+    assert checkpoint.latest_step(cfg.run_dir) == 6 and [r["iteration"] for r in records(cfg.run_dir)] == [2, 4, 6]
+    plain = config(tmp_path, "plain", checkpoint_every=0)  # saved once, at the end
+    run(plain)
+    like = jax.eval_shape(Toy(ENV, cfg).init, jax.random.PRNGKey(0))
+    assert jax.tree.all(jax.tree.map(np.array_equal, restored(cfg.run_dir, like), restored(plain.run_dir, like)))
+
+
+def test_a_failed_write_stops_the_run_at_the_next_checkpoint_keeping_the_one_before(tmp_path, monkeypatch):
+    cfg = config(tmp_path, checkpoint_every=1)
+    save = checkpoint.save
+
+    def failing(run_dir, step, *a, **kw):
+        if step == 4:
+            raise OSError(28, "No space left on device")
+        return save(run_dir, step, *a, **kw)
+
+    monkeypatch.setattr(checkpoint, "save", failing)
+    with pytest.raises(checkpoint.NoSpace, match="the checkpoint at iteration 2 is kept"):
+        run(cfg)
+    assert checkpoint.latest_step(cfg.run_dir) == 2
+
+
 def test_a_signal_during_a_chunk_saves_the_newest_whole_state(tmp_path):
     cfg = config(tmp_path, iterations=400, checkpoint_every=0)
     toy = Toy(ENV, cfg, sleep=0.2)

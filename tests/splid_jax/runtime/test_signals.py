@@ -51,6 +51,15 @@ def test_a_save_past_its_grace_is_abandoned():
     release.set()
 
 
+def test_work_begun_runs_beside_the_caller_and_hands_back_its_result_or_error():
+    s, release = Signals(), threading.Event()
+    began = s.begin(lambda: release.wait(30) and "built")
+    release.set()  # only a thread already running can see it: begin returned without waiting
+    assert s.wait(began) == "built"
+    with pytest.raises(ValueError, match="no state"):
+        s.wait(s.begin(lambda: (_ for _ in ()).throw(ValueError("no state"))))
+
+
 HANGS_AT_10 = """
 import runpy, sys, threading
 from splid_jax.runtime import checkpoint
