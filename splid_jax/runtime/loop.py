@@ -2,11 +2,13 @@
 
 Python runs only between compiled chunks: it logs, writes metrics.jsonl (one schema for every
 algorithm, run and sweep), evaluates through the chunk, checkpoints with orbax, stops on NaN, and
-resumes bit for bit. The chunk is traced, checked against the device's memory and compiled once
-(``jax.jit(...).trace(...).lower().compile()``) before any state is allocated, so a run that cannot
-fit is refused with its estimate and the compile is timed apart from the first chunk. The initial
-state is built while XLA compiles, and on one process each checkpoint is written while the next chunk
-runs (Push's state writes in 0.2 to 0.3 s on a GPU host, five HER seeds' in about 2 s on a 2-core CPU).
+resumes bit for bit. The state's size is checked against the device's memory before anything is
+built, and the chunk's intermediates once it is traced; the chunk is compiled once
+(``jax.jit(...).trace(...).lower().compile()``), timed apart from the first chunk. Meanwhile the keys,
+the settings and the initial state are built on the device (on one H200 the memory check, when it
+ran the first program, took 2.3 s before the trace), and on one process each checkpoint is
+written while the next chunk runs (Push's state in 0.2 to 0.3 s on a GPU host, five HER seeds' in
+about 2 s on a 2-core CPU).
 
 A signal stops the run at any moment with its newest whole state checkpointed (``signals``); the run
 directory's files are ``run_files``', the memory check ``memory``'s, a sweep split over devices
@@ -245,18 +247,29 @@ class _Loop:
                 return jnp.stack(keys), jax.tree.map(lambda *x: jnp.stack(x), *hypers)
             return keys[0], hypers[0]
 
-        keys, hyper = self.signals.wait(stack)
+        keys_like, hyper_like = self.signals.wait(lambda: jax.eval_shape(stack))  # no device work yet
         init, chunk = algo.init, algo.chunk
         if self.stacked:
             init, chunk = jax.vmap(init), jax.vmap(chunk)
         groups = Groups(place, len(self.lanes)) if split else None
         sharding = place.state_sharding() if groups is None else jax.sharding.SingleDeviceSharding(self.device)
-        like = _abstract(jax.eval_shape(init, keys), sharding)  # the whole sweep's, as checkpoints hold it
+        like = _abstract(jax.eval_shape(init, keys_like), sharding)  # the whole sweep's, as checkpoints hold it
         one = like if groups is None else groups.first(like)  # what one compiled program takes
-        hyper = _canonical(hyper, sharding)
+        hyper_one = _abstract(hyper_like, sharding)  # strongly typed, as _canonical makes the values
+
+        def made():  # the device's first programs, built while the chunk is traced and compiled
+            keys, hyper = stack()
+            if resume:
+                return _canonical(hyper, sharding), None
+            state = initial_state(algo.init, keys, self.stacked, self.device.platform == "cpu")
+            return _canonical(hyper, sharding), _canonical(state, sharding)
+
+        building = self.signals.begin(made)
         t0 = time.perf_counter()
         try:
-            traced = self.signals.wait(lambda: jax.jit(chunk).trace(one, groups.first(hyper) if groups else hyper))
+            traced = self.signals.wait(
+                lambda: jax.jit(chunk).trace(one, groups.first(hyper_one) if groups else hyper_one)
+            )
         except OverflowError as e:  # an index past int32: sizes far beyond any device's memory
             raise DoesNotFit(
                 f"invalid sizes ({sizes(cfg, len(self.lanes))}): too large for the program's 32-bit indices, "
@@ -274,8 +287,6 @@ class _Loop:
                   + (f" members={len(self.lanes)}" if self.stacked else ""))  # fmt: skip
         self.show(f"compiling the training program ({compile_hint(self.env)}; "
                   "less when the compile cache holds it)...")  # fmt: skip
-        first = lambda: initial_state(algo.init, keys, self.stacked, self.device.platform == "cpu")  # noqa: E731
-        initial = None if resume else self.signals.begin(first)  # built on the device while XLA compiles the chunk
         t0 = time.perf_counter()
         try:
             compiled = self.signals.wait(lambda: traced.lower().compile())
@@ -285,6 +296,7 @@ class _Loop:
                 raise
             raise InvalidConfig("env_options", cfg.env_options, hint) from e
         analysis = compiled.memory_analysis()
+        hyper, initial = self.signals.wait(building)
         if groups is not None:
             compiled = groups.compile(compiled, lambda dev: jax.jit(chunk).trace(
                 groups.on(one, dev), groups.on(groups.first(hyper), dev)).lower().compile(), self.signals)  # fmt: skip
@@ -297,8 +309,7 @@ class _Loop:
         if resume:
             state, select_steps, wall_before = self.restore(like)
         else:
-            state = _canonical(self.signals.wait(initial), sharding)
-            state = state if groups is None else groups.split(state)
+            state = initial if groups is None else groups.split(initial)
             select_steps, wall_before = [0] * len(self.lanes), 0.0
             for lane in self.lanes if self.writes else ():
                 os.makedirs(lane.run_dir, exist_ok=True)
@@ -318,7 +329,8 @@ class _Loop:
     def check_state_fits(self, split: bool) -> None:
         """One member's state times the members a device holds, twice (the state and its update),
         against the device's memory: a grid of thousands is refused before anything is stacked or traced."""
-        one = sum(nbytes(x) for x in jax.tree.leaves(jax.eval_shape(self.algo.init, jax.random.PRNGKey(0))))
+        key = jax.eval_shape(jax.random.PRNGKey, 0)  # abstract: the device's first program is built beside the trace
+        one = sum(nbytes(x) for x in jax.tree.leaves(jax.eval_shape(self.algo.init, key)))
         held = -(-len(self.lanes) // self.place.count) if split else len(self.lanes)
         what = f"state {gigabytes(one)} per member x {held} members, twice" if self.stacked else "state twice"
         check_memory(2 * one * held, what, self.device, self.cfg, len(self.lanes))

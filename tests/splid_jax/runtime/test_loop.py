@@ -289,6 +289,23 @@ def test_a_checkpoint_is_written_while_the_next_chunk_runs(tmp_path, monkeypatch
     assert jax.tree.all(jax.tree.map(np.array_equal, restored(cfg.run_dir, like), restored(plain.run_dir, like)))
 
 
+def test_the_initial_state_is_built_while_the_chunk_is_traced(tmp_path, monkeypatch):
+    built, seen = threading.Event(), []
+    initial_state = loop.initial_state
+    monkeypatch.setattr(loop, "initial_state", lambda *a: (initial_state(*a), built.set())[0])
+
+    @dataclasses.dataclass
+    class TracedAfterInit(Toy):
+        def chunk(self, state, hyper):  # its trace goes on once the initial state exists (at most 30 s)
+            seen.append(built.wait(30))
+            return super().chunk(state, hyper)
+
+    cfg = config(tmp_path)
+    loop.run(cfg, ENV, algo=TracedAfterInit(ENV, cfg), quiet=True)
+    assert seen[:1] == [True]
+    assert [r["iteration"] for r in records(cfg.run_dir)] == [2, 4, 6]
+
+
 def test_a_failed_write_stops_the_run_at_the_next_checkpoint_keeping_the_one_before(tmp_path, monkeypatch):
     cfg = config(tmp_path, checkpoint_every=1)
     save = checkpoint.save
