@@ -296,15 +296,15 @@ class _Loop:
                 raise
             raise InvalidConfig("env_options", cfg.env_options, hint) from e
         analysis = compiled.memory_analysis()
-        hyper, initial = self.signals.wait(building)
         if groups is not None:
-            compiled = groups.compile(compiled, lambda dev: jax.jit(chunk).trace(
-                groups.on(one, dev), groups.on(groups.first(hyper), dev)).lower().compile(), self.signals)  # fmt: skip
-            hyper = groups.split(hyper)
+            on_device = lambda dev: jax.jit(chunk).trace(groups.on(one, dev), groups.on(groups.first(hyper_one), dev))  # noqa: E731
+            compiled = groups.compile(compiled, lambda dev: on_device(dev).lower().compile(), self.signals)
         self.show(f"compiled in {time.perf_counter() - t0:.1f} s (traced before it in {traced_s:.1f} s)")
         if analysis is not None:
             need = analysis.argument_size_in_bytes + analysis.output_size_in_bytes + analysis.temp_size_in_bytes
             check_memory(need - analysis.alias_size_in_bytes, "as compiled", self.device, cfg, len(self.lanes))
+        hyper, initial = self.signals.wait(building)
+        hyper = hyper if groups is None else groups.split(hyper)
 
         if resume:
             state, select_steps, wall_before = self.restore(like)
