@@ -28,6 +28,7 @@ import numpy as np
 
 from envs import kernel_batch
 from envs.base import data_with
+from envs.fused_solver import at_mask
 from envs.small_cholesky import TRACE_LOCK
 
 _FACE = np.array([0, 4, 5, 1, 0, 2, 6, 4, 6, 7, 5, 4, 2, 3, 7, 6, 1, 5, 7, 3, 0, 1, 3, 2]).reshape(6, 4)
@@ -102,14 +103,9 @@ def _argmax(x, index):
     return _first_index(x == jnp.max(x), index)
 
 
-def _at(x, index, i):
-    """x[i] for an array ``x`` of ``index``'s shape, as a masked sum (a Triton kernel has no gather)."""
-    return jnp.sum(jnp.where(index == i, x, 0.0))
-
-
 def _pick(a, index, i):
-    """a[i] for a vector ``a`` whose components share ``index``'s shape."""
-    return tuple(_at(x, index, i) for x in a)
+    """a[i] for a vector ``a`` whose components share ``index``'s shape (a Triton kernel has no gather)."""
+    return tuple(at_mask(x, index == i) for x in a)
 
 
 def _corner(index, c: int, dtype):
@@ -256,7 +252,7 @@ def box_box_soa(pos1, mat1, size1, pos2, mat2, size2):
     degenerate = ax_i >= 21
     for f in range(6):
         for c in range(3):
-            axes[c] = jnp.where(ax_i == f, _at(na[c], jnp.arange(NF), f), axes[c])
+            axes[c] = jnp.where(ax_i == f, at_mask(na[c], jnp.arange(NF) == f), axes[c])
             axes[c] = jnp.where(ax_i == 6 + f, float(_NORMAL[f, c]), axes[c])
     for q in range(9):
         cr = _cross(ea[q % 3], eb[q // 3])
@@ -276,7 +272,7 @@ def box_box_soa(pos1, mat1, size1, pos2, mat2, size2):
     best_face_idx = _argmin(jnp.where(ax_i < 12, support, BIG), ax_i)
     best_face_axis = _pick(axes, ax_i, best_face_idx)
     best_idx = _argmin(support, ax_i)
-    best_sign = _at(sign, ax_i, best_idx)
+    best_sign = at_mask(sign, ax_i == best_idx)
     best_axis = _pick(axes, ax_i, best_idx)
     is_edge = (best_idx >= 12) & (jnp.abs(_dot(best_face_axis, best_axis)) < 0.99)
     f_i = jnp.arange(NF)
@@ -322,7 +318,7 @@ def plane_box_soa(plane_pos, plane_mat, box_pos, box_mat, box_size):
     i4 = jnp.arange(4)
     idx = _vec4(best)
     local = tuple(_vec4([_pick(vert, vi, i)[c] for i in best]) for c in range(3))
-    depth = _vec4([_at(support, vi, i) for i in best])
+    depth = _vec4([at_mask(support, vi == i) for i in best])
     earlier = sum(jnp.where((i4 > j) & (idx == best[j]), 1, 0) for j in range(4))  # a point chosen before
     dist = jnp.where(earlier == 0, -depth, 0.0 * depth + 1.0)
     world = _add(tuple(jnp.broadcast_to(x, (4,)) for x in box_pos), _matvec(bm, local))
@@ -373,7 +369,7 @@ def _kernel(soa_fn, *args, interpret=False, num_warps=None):
     def kernel(in_ref, out_ref):
         x = in_ref[...]
         i32 = jnp.arange(32)
-        v = [_at(x, i32, k) for k in range(flat.shape[0])]
+        v = [at_mask(x, i32 == k) for k in range(flat.shape[0])]
         values, at = [], 0
         for shape in shapes:
             if shape == (3,):
@@ -386,7 +382,7 @@ def _kernel(soa_fn, *args, interpret=False, num_warps=None):
         out = jnp.zeros((32,), x.dtype)
         for blk, arr in enumerate((dist, *world)):
             for i in range(4):
-                out = jnp.where(i32 == blk * 4 + i, _at(arr, i4, i), out)
+                out = jnp.where(i32 == blk * 4 + i, at_mask(arr, i4 == i), out)
         for r in range(3):
             for c in range(3):
                 out = jnp.where(i32 == 16 + 3 * r + c, rows[r][c], out)

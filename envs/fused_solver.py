@@ -33,15 +33,16 @@ MINVAL = 1e-15  # mujoco.mjMINVAL
 
 
 def at_mask(x, mask):
+    """The entry of ``x`` where ``mask`` holds, as a masked sum (a Triton kernel has no gather)."""
     return jnp.sum(jnp.where(mask, x, 0.0))
 
 
-def row_at(a, k: int):
+def _row(a, k: int):
     """a[k, :], picked with a mask."""
     return jnp.sum(jnp.where(jnp.arange(a.shape[0])[:, None] == k, a, 0.0), axis=0)
 
 
-def col_at(a, k: int):
+def _col(a, k: int):
     """a[:, k], picked with a mask."""
     return jnp.sum(jnp.where(jnp.arange(a.shape[1])[None, :] == k, a, 0.0), axis=1)
 
@@ -55,19 +56,19 @@ def chol_solve(a, b, size: int | None = None):
     idx = jnp.arange(n)
     low = jnp.zeros_like(a)
     for k in range(size):  # column k of L from the columns before it
-        s = jnp.sum(jnp.where(idx[None, :] < k, low * row_at(low, k)[None, :], 0.0), axis=1)  # sum_{m<k} L[:,m] L[k,m]
-        col = col_at(a, k) - s
+        s = jnp.sum(jnp.where(idx[None, :] < k, low * _row(low, k)[None, :], 0.0), axis=1)  # sum_{m<k} L[:,m] L[k,m]
+        col = _col(a, k) - s
         diag = jnp.sqrt(jnp.maximum(at_mask(col, idx == k), MINVAL))
         newcol = jnp.where(idx == k, diag, jnp.where(idx > k, col / diag, 0.0))
         low = jnp.where(idx[None, :] == k, newcol[:, None], low)
     diag = jnp.sum(jnp.where(idx[:, None] == idx[None, :], low, 0.0), axis=1)
     y = jnp.zeros_like(b)
     for k in range(size):  # forward: L y = b
-        yk = (at_mask(b, idx == k) - jnp.sum(jnp.where(idx < k, row_at(low, k) * y, 0.0))) / at_mask(diag, idx == k)
+        yk = (at_mask(b, idx == k) - jnp.sum(jnp.where(idx < k, _row(low, k) * y, 0.0))) / at_mask(diag, idx == k)
         y = jnp.where(idx == k, yk, y)
     x = jnp.zeros_like(b)
     for k in reversed(range(size)):  # backward: L^T x = y
-        xk = (at_mask(y, idx == k) - jnp.sum(jnp.where(idx > k, col_at(low, k) * x, 0.0))) / at_mask(diag, idx == k)
+        xk = (at_mask(y, idx == k) - jnp.sum(jnp.where(idx > k, _col(low, k) * x, 0.0))) / at_mask(diag, idx == k)
         x = jnp.where(idx == k, xk, x)
     return x
 
@@ -208,7 +209,7 @@ def newton(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *, itera
     return c["qacc"], c["qfrc"], c["force"]
 
 
-def pow2(n: int) -> int:
+def _pow2(n: int) -> int:
     return 1 << max(0, (n - 1).bit_length())
 
 
@@ -222,7 +223,7 @@ def kernel_solve(j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, trace_m, *,
     from jax.experimental.pallas import triton as pl_triton
 
     nefc, nv = j.shape
-    p, v = pow2(max(nefc, 16)), pow2(max(nv, 16))
+    p, v = _pow2(max(nefc, 16)), _pow2(max(nv, 16))
     f32 = j.dtype
     pad_r = lambda x: jnp.pad(x, (0, p - nefc))  # noqa: E731
     pad_v = lambda x: jnp.pad(x, (0, v - nv))  # noqa: E731

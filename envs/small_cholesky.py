@@ -70,14 +70,13 @@ def lower_solve(low: jax.Array, b: jax.Array) -> jax.Array:
     return jnp.stack(x)
 
 
-def takes(a) -> bool:
-    """Whether ``a`` is one square matrix small enough to write out (batched ones go to the library)."""
+def _unrolled(a) -> bool:
     return jnp.ndim(a) == 2 and a.shape[0] == a.shape[1] and a.shape[0] <= MAX_UNROLLED
 
 
 def cho_factor(a, lower: bool = False, overwrite_a: bool = False, check_finite: bool = True):
     """``jax.scipy.linalg.cho_factor``: (the upper factor, or the lower one if ``lower``, ``lower``)."""
-    if not takes(a):
+    if not _unrolled(a):
         return _LIBRARY[0](a, lower=lower, overwrite_a=overwrite_a, check_finite=check_finite)
     # The barrier makes XLA compute the matrix once, before the factorisation's fused kernel, instead of
     # fusing its producer in: Push substep 4.65 -> 4.42 ms, its Newton solve 3.22 -> 2.74 ms (H200,
@@ -90,7 +89,7 @@ def cho_solve(c_and_lower, b, overwrite_b: bool = False, check_finite: bool = Tr
     """``jax.scipy.linalg.cho_solve`` for a factor from either ``cho_factor``."""
     c, lower = c_and_lower
     b = jnp.asarray(b)
-    if not takes(c) or b.ndim not in (1, 2) or b.shape[0] != c.shape[0]:
+    if not _unrolled(c) or b.ndim not in (1, 2) or b.shape[0] != c.shape[0]:
         return _LIBRARY[1](c_and_lower, b, overwrite_b=overwrite_b, check_finite=check_finite)
     return lower_solve(c if lower else c.T, b)
 
@@ -99,21 +98,14 @@ def cho_solve(c_and_lower, b, overwrite_b: bool = False, check_finite: bool = Tr
 def unrolled_in_mjx(enabled: bool = True):
     """Within the block, ``jax.scipy.linalg.cho_factor`` / ``cho_solve`` are the unrolled ones above.
 
-    Meant around the trace of MJX calls (``mjx.step`` inside a jitted function)."""
+    Meant around the trace of MJX calls (``mjx.step`` inside a jitted function). The (re-entrant)
+    lock keeps two threads from tracing through it at once."""
     if not enabled:
         yield
         return
-    with linalg_swapped(cho_factor, cho_solve):
-        yield
-
-
-@contextlib.contextmanager
-def linalg_swapped(factor, solve):
-    """Within the block, ``jax.scipy.linalg.cho_factor`` / ``cho_solve`` are ``factor`` / ``solve``; the
-    (re-entrant) lock keeps two threads from tracing through a swap at once."""
     with TRACE_LOCK:
         saved = (jsl.cho_factor, jsl.cho_solve)
-        jsl.cho_factor, jsl.cho_solve = factor, solve
+        jsl.cho_factor, jsl.cho_solve = cho_factor, cho_solve
         try:
             yield
         finally:

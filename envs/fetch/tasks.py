@@ -42,12 +42,11 @@ MIN_OBJECT_DISTANCE = 0.1  # the object starts at least this far from the grippe
 _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4) ** 64 ~ 2e-7
 GOAL_LIFT_MAX = 0.45
 GRASP_ABOVE_SITE = 0.01  # a grasped cube's centre above the grip site: inside the fingers' 6 cm height
-CHOLESKY = ("unrolled", "library")  # small_cholesky.py's, jax.scipy.linalg's
+CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
 # MJX's solver loops, both written out, the line search alone written out, each of the last two on a GPU only, and
 # the whole solve as one program per env (envs/fused_solver.py), always or on a GPU only
 SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused", "gpu-fused")
-# contacts (plane-box and box-box): MJX's, or envs/fused_collision.py's always or on a GPU only
-MJX_OR_FUSED = ("mjx", "fused", "gpu-fused")
+COLLISION = ("mjx", "fused", "gpu-fused")  # plane-box and box-box contacts: MJX's, or envs/fused_collision.py's
 KERNELS = ("fused", "gpu-fused")  # the choices above that run a part of the physics as a Pallas kernel
 
 
@@ -116,7 +115,7 @@ class _FetchTask(GoalEnv):
     table: str = experimental("plane")
     # the closed finger block's collision shape (Push: pads, box or capsule, see models.py)
     finger: str = experimental("box")
-    # how MJX factors its small dense systems: written out (envs/small_cholesky.py) or "library"
+    # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     cholesky: str = experimental("unrolled")
     # MJX's Newton solver as its loops, written out (unrolled), its line search alone written out (search),
     # or either on a GPU only (auto, gpu-search; envs/solver_loops.py), or the whole solve one program per env, a
@@ -176,8 +175,8 @@ class _FetchTask(GoalEnv):
         ok = self.solver_loops in SOLVER_LOOPS
         check(ok, f"{n}.solver_loops", self.solver_loops, "one of " + ", ".join(SOLVER_LOOPS))
         check_integer(f"{n}.kernel_envs", self.kernel_envs, 0)
-        ok = self.collision in MJX_OR_FUSED
-        check(ok, f"{n}.collision", self.collision, "one of " + ", ".join(MJX_OR_FUSED))
+        ok = self.collision in COLLISION
+        check(ok, f"{n}.collision", self.collision, "one of " + ", ".join(COLLISION))
         grasp_range = "in [0, 1]" if not self.block_gripper else "0 (the fingers are locked on this task)"
         ok = 0 <= self.grasped_starts <= 1 and (self.grasped_starts == 0 or not self.block_gripper)
         check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
