@@ -289,20 +289,29 @@ def test_a_checkpoint_is_written_while_the_next_chunk_runs(tmp_path, monkeypatch
     assert jax.tree.all(jax.tree.map(np.array_equal, restored(cfg.run_dir, like), restored(plain.run_dir, like)))
 
 
-def test_the_initial_state_is_built_while_the_chunk_is_traced(tmp_path, monkeypatch):
-    built, seen = threading.Event(), []
-    initial_state = loop.initial_state
-    monkeypatch.setattr(loop, "initial_state", lambda *a: (initial_state(*a), built.set())[0])
+def test_the_initial_state_is_built_while_the_chunk_is_compiled_not_traced(tmp_path, monkeypatch):
+    events, built = [], threading.Event()
+    initial_state, compile_ = loop.initial_state, jax.stages.Lowered.compile
+    monkeypatch.setattr(loop, "initial_state", lambda *a: (events.append("init"), initial_state(*a), built.set())[1])
+
+    def compile_after_init(self, *a, **kw):  # goes on once the initial state exists (at most 30 s)
+        waited = built.wait(30)
+        events.append(("compile", waited))
+        return compile_(self, *a, **kw)
+
+    monkeypatch.setattr(jax.stages.Lowered, "compile", compile_after_init)
 
     @dataclasses.dataclass
-    class TracedAfterInit(Toy):
-        def chunk(self, state, hyper):  # its trace goes on once the initial state exists (at most 30 s)
-            seen.append(built.wait(30))
+    class Recorded(Toy):
+        def chunk(self, state, hyper):  # a slow trace: time enough for an initial state built beside it
+            events.append("trace")
+            time.sleep(0.5)
+            events.append("traced")
             return super().chunk(state, hyper)
 
     cfg = config(tmp_path)
-    loop.run(cfg, ENV, algo=TracedAfterInit(ENV, cfg), quiet=True)
-    assert seen[:1] == [True]
+    loop.run(cfg, ENV, algo=Recorded(ENV, cfg), quiet=True)
+    assert events[:4] == ["trace", "traced", "init", ("compile", True)]
     assert [r["iteration"] for r in records(cfg.run_dir)] == [2, 4, 6]
 
 
