@@ -36,7 +36,10 @@ class Algorithm(Protocol):
 
         The metrics are scalars and hold ``EVAL_KEYS``, ``finite`` (bool: no NaN in parameters or
         losses) and, where the algorithm replays the simulator beyond exploration, ``select_steps``
-        ([eval_every] int32, summed by the host in int64). Other keys are the algorithm's own."""
+        ([eval_every] int32, summed by the host in int64). Other keys are the algorithm's own.
+
+        An algorithm may also split it as ``trained(state, hyper) -> (state, done)`` and ``report(state,
+        hyper, done) -> metrics`` (``Chunked`` does); the host loop then compiles two programs at once."""
 
     def counters(self, iteration: int, select_steps: int) -> dict:
         """Exploration work after ``iteration`` iterations as exact Python ints: ``iteration``,
@@ -77,16 +80,27 @@ class Chunked:
         return self.cfg.num_envs
 
     def chunk(self, state: Any, hyper: Any) -> tuple[Any, dict]:
+        state, done = self.trained(state, hyper)
+        return state, self.report(state, hyper, done)
+
+    def trained(self, state: Any, hyper: Any) -> tuple[Any, tuple]:
+        """The chunk's training, a program of its own: the host loop compiles it and ``report`` side by
+        side, as XLA optimises one program on one thread. Returns the state and what ``report`` reads."""
         state, per_iteration = jax.lax.scan(
             lambda s, _: self.iteration(s, hyper), state, None, length=self.cfg.eval_every
         )
         key, k_eval = jax.random.split(state.key)
+        return state.replace(key=key), (per_iteration, k_eval)
+
+    def report(self, state: Any, hyper: Any, done: tuple) -> dict:
+        """The chunk's metrics: the deterministic policy evaluated, the learner's own, NaN checks."""
+        per_iteration, k_eval = done
         policy = steered(self.policy, self.env, self.cfg.eval_subgoal_reach)
         metrics = evaluate(self.env, policy, state.policy, k_eval, self.cfg.eval_episodes)
         metrics.update(self.chunk_metrics(state, hyper, per_iteration))
         params, losses_finite = self.watched(state, per_iteration)
         metrics["finite"] = params_finite(params) & jnp.all(losses_finite)
-        return state.replace(key=key), metrics
+        return metrics
 
     def counters(self, iteration: int, select_steps: int) -> dict:
         """Work done after ``iteration`` iterations, as exact Python ints: exploration episodes and env

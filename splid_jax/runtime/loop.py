@@ -3,10 +3,10 @@
 Python runs only between compiled chunks: it logs, writes metrics.jsonl (one schema for every
 algorithm, run and sweep), evaluates through the chunk, checkpoints with orbax, stops on NaN, and
 resumes bit for bit. The state's size is checked against the device's memory before anything is
-built, and the chunk's intermediates once it is traced; the chunk is compiled once
-(``jax.jit(...).trace(...).lower().compile()``), timed apart from the first chunk. While XLA compiles,
-the keys, the settings and the initial state are built on the device in a thread (built beside the
-trace, they slowed it: 12.8 s against 7.0 on one H100), and on one process each checkpoint is
+built, and the chunk's intermediates once it is traced; the chunk is compiled once, a learner's
+training and report as two programs side by side (``programs``), timed apart from the first chunk.
+While XLA compiles, the keys, the settings and the initial state are built on the device in a thread
+(built beside the trace, they slowed it: 12.8 s against 7.0 on one H100), and on one process each checkpoint is
 written while the next chunk runs (Push's state in 0.2 to 0.3 s on a GPU host, five HER seeds' in
 about 2 s on a 2-core CPU).
 
@@ -36,9 +36,9 @@ from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 from splid_jax.learners import registry
 from splid_jax.learners.base import EVAL_KEYS, Algorithm
-from splid_jax.runtime import checkpoint, devices, lock, multihost, progress
+from splid_jax.runtime import checkpoint, devices, lock, multihost, programs, progress
 from splid_jax.runtime.groups import Groups
-from splid_jax.runtime.memory import DoesNotFit, check_memory, compile_hint, gigabytes, largest_value, nbytes, sizes
+from splid_jax.runtime.memory import DoesNotFit, check_memory, compile_hint, gigabytes, nbytes, sizes
 from splid_jax.runtime.run_files import (
     METRICS,
     SWEEP,
@@ -248,9 +248,8 @@ class _Loop:
             return keys[0], hypers[0]
 
         keys_like, hyper_like = self.signals.wait(lambda: jax.eval_shape(stack))  # no device work yet
-        init, chunk = algo.init, algo.chunk
-        if self.stacked:
-            init, chunk = jax.vmap(init), jax.vmap(chunk)
+        init = jax.vmap(algo.init) if self.stacked else algo.init
+        fns = programs.parts(algo, self.stacked)
         groups = Groups(place, len(self.lanes)) if split else None
         sharding = place.state_sharding() if groups is None else jax.sharding.SingleDeviceSharding(self.device)
         like = _abstract(jax.eval_shape(init, keys_like), sharding)  # the whole sweep's, as checkpoints hold it
@@ -267,7 +266,7 @@ class _Loop:
         t0 = time.perf_counter()
         try:
             traced = self.signals.wait(
-                lambda: jax.jit(chunk).trace(one, groups.first(hyper_one) if groups else hyper_one)
+                lambda: programs.trace(fns, one, groups.first(hyper_one) if groups else hyper_one)
             )
         except OverflowError as e:  # an index past int32: sizes far beyond any device's memory
             raise DoesNotFit(
@@ -276,7 +275,7 @@ class _Loop:
             ) from e
         traced_s = time.perf_counter() - t0
         state_bytes = sum(nbytes(x) for x in jax.tree.leaves(one))
-        largest = largest_value(traced.jaxpr.jaxpr)
+        largest = programs.largest(traced)
         what = f"state {gigabytes(state_bytes)} twice, largest intermediate {gigabytes(largest)}"
         check_memory(2 * state_bytes + largest, what, self.device, cfg, len(self.lanes))
 
@@ -289,20 +288,20 @@ class _Loop:
         building = self.signals.begin(made)  # beside the compile: beside the trace it slowed the trace
         t0 = time.perf_counter()
         try:
-            compiled = self.signals.wait(lambda: traced.lower().compile())
+            compiled = programs.compile_all(traced, self.signals)
         except Exception as e:  # re-raised unless it is a physics kernel's
             hint = self.env.kernel_fallback(e)
             if hint is None:
                 raise
             raise InvalidConfig("env_options", cfg.env_options, hint) from e
-        analysis = compiled.memory_analysis()
+        need = compiled.bytes_needed()
         if groups is not None:
-            on_device = lambda dev: jax.jit(chunk).trace(groups.on(one, dev), groups.on(groups.first(hyper_one), dev))  # noqa: E731
-            compiled = groups.compile(compiled, lambda dev: on_device(dev).lower().compile(), self.signals)
+            on_device = lambda dev: programs.trace(fns, groups.on(one, dev), groups.on(groups.first(hyper_one), dev))  # noqa: E731
+            compiled = groups.compile(compiled, lambda dev: programs.compile_all(on_device(dev), self.signals),
+                                      self.signals)  # fmt: skip
         self.show(f"compiled in {time.perf_counter() - t0:.1f} s (traced before it in {traced_s:.1f} s)")
-        if analysis is not None:
-            need = analysis.argument_size_in_bytes + analysis.output_size_in_bytes + analysis.temp_size_in_bytes
-            check_memory(need - analysis.alias_size_in_bytes, "as compiled", self.device, cfg, len(self.lanes))
+        if need is not None:
+            check_memory(need, "as compiled", self.device, cfg, len(self.lanes))
         hyper, initial = self.signals.wait(building)
         hyper = hyper if groups is None else groups.split(hyper)
 
