@@ -4,10 +4,9 @@ Python runs only between compiled chunks: it logs, writes metrics.jsonl (one sch
 algorithm, run and sweep), evaluates through the chunk, checkpoints with orbax, stops on NaN, and
 resumes bit for bit. The state's size is checked against the device's memory before anything is
 built, and the chunk's intermediates once it is traced; the chunk is compiled once, a learner's
-training and report as two programs, the report traced while the training compiles (``programs``),
-timed apart from the first chunk. While XLA compiles, the keys, the settings and the initial state
-are built on the device in a thread (built beside the trace, they slowed it: 12.8 s against 7.0 on
-one H100), and on one process each checkpoint is
+training and report as two programs side by side (``programs``), timed apart from the first chunk.
+While XLA compiles, the keys, the settings and the initial state are built on the device in a thread
+(built beside the trace, they slowed it: 12.8 s against 7.0 on one H100), and on one process each checkpoint is
 written while the next chunk runs (Push's state in 0.2 to 0.3 s on a GPU host, five HER seeds' in
 about 2 s on a 2-core CPU).
 
@@ -39,7 +38,7 @@ from splid_jax.learners import registry
 from splid_jax.learners.base import EVAL_KEYS, Algorithm
 from splid_jax.runtime import checkpoint, devices, lock, multihost, programs, progress
 from splid_jax.runtime.groups import Groups
-from splid_jax.runtime.memory import DoesNotFit, check_memory, compile_hint, gigabytes, largest_value, nbytes, sizes
+from splid_jax.runtime.memory import DoesNotFit, check_memory, compile_hint, gigabytes, nbytes, sizes
 from splid_jax.runtime.run_files import (
     METRICS,
     SWEEP,
@@ -267,7 +266,7 @@ class _Loop:
         t0 = time.perf_counter()
         try:
             traced = self.signals.wait(
-                lambda: jax.jit(fns[0]).trace(one, groups.first(hyper_one) if groups else hyper_one)
+                lambda: programs.trace(fns, one, groups.first(hyper_one) if groups else hyper_one)
             )
         except OverflowError as e:  # an index past int32: sizes far beyond any device's memory
             raise DoesNotFit(
@@ -276,13 +275,9 @@ class _Loop:
             ) from e
         traced_s = time.perf_counter() - t0
         state_bytes = sum(nbytes(x) for x in jax.tree.leaves(one))
-
-        def check_traced(part):  # the state and its update, and the largest value one operation makes
-            largest = largest_value(part.jaxpr.jaxpr)
-            what = f"state {gigabytes(state_bytes)} twice, largest intermediate {gigabytes(largest)}"
-            check_memory(2 * state_bytes + largest, what, self.device, cfg, len(self.lanes))
-
-        check_traced(traced)
+        largest = programs.largest(traced)
+        what = f"state {gigabytes(state_bytes)} twice, largest intermediate {gigabytes(largest)}"
+        check_memory(2 * state_bytes + largest, what, self.device, cfg, len(self.lanes))
 
         processes = f" of {jax.process_count()} processes" if jax.process_count() > 1 else ""
         on = f"{place.count} devices{processes} split by {place.axis}" if place.count > 1 else self.device.platform
@@ -290,12 +285,10 @@ class _Loop:
                   + (f" members={len(self.lanes)}" if self.stacked else ""))  # fmt: skip
         self.show(f"compiling the training program ({compile_hint(self.env)}; "
                   "less when the compile cache holds it)...")  # fmt: skip
+        building = self.signals.begin(made)  # beside the compile: beside the trace it slowed the trace
         t0 = time.perf_counter()
-        finish = programs.start(fns, traced, one, groups.first(hyper_one) if groups else hyper_one, self.signals,
-                                check_traced)  # fmt: skip
-        building = self.signals.begin(made)  # beside the compiles: beside a trace it slowed the trace
         try:
-            compiled = finish()
+            compiled = programs.compile_all(traced, self.signals)
         except Exception as e:  # re-raised unless it is a physics kernel's
             hint = self.env.kernel_fallback(e)
             if hint is None:
@@ -303,13 +296,9 @@ class _Loop:
             raise InvalidConfig("env_options", cfg.env_options, hint) from e
         need = compiled.bytes_needed()
         if groups is not None:
-
-            def on_device(dev):
-                like, hyper_like = groups.on(one, dev), groups.on(groups.first(hyper_one), dev)
-                first = jax.jit(fns[0]).trace(like, hyper_like)
-                return programs.start(fns, first, like, hyper_like, self.signals, lambda _: None)()
-
-            compiled = groups.compile(compiled, on_device, self.signals)
+            on_device = lambda dev: programs.trace(fns, groups.on(one, dev), groups.on(groups.first(hyper_one), dev))  # noqa: E731
+            compiled = groups.compile(compiled, lambda dev: programs.compile_all(on_device(dev), self.signals),
+                                      self.signals)  # fmt: skip
         self.show(f"compiled in {time.perf_counter() - t0:.1f} s (traced before it in {traced_s:.1f} s)")
         if need is not None:
             check_memory(need, "as compiled", self.device, cfg, len(self.lanes))

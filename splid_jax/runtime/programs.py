@@ -1,5 +1,5 @@
 """The chunk as the device runs it: one program, or a learner's training and report (its evaluation and
-metrics) as two programs, the report traced and compiled while the training compiles, called as one.
+metrics) as two programs compiled side by side and called as one.
 
 XLA optimises a program's HLO on one thread, and each copy of the physics step in a program costs
 seconds of it (exploration's, SELECT's and evaluation's in a SPLID chunk), so two programs compile in
@@ -13,6 +13,7 @@ from typing import Any
 
 import jax
 
+from splid_jax.runtime.memory import largest_value
 from splid_jax.runtime.signals import Signals
 
 
@@ -24,14 +25,23 @@ def parts(algo, stacked: bool) -> list[Callable]:
     return [jax.vmap(f) for f in fns] if stacked else fns
 
 
-def done_like(first: jax.stages.Traced, state_like):
-    """What the report takes beside the state and settings: the training's second output, abstract,
-    placed as the state."""
+def trace(fns: list[Callable], state_like, hyper_like) -> list[jax.stages.Traced]:
+    """Each part traced on abstract arguments; the report's state is the training's (the same shapes
+    and placement), the rest of its input the training's second output, placed as the state."""
+    first = jax.jit(fns[0]).trace(state_like, hyper_like)
+    if len(fns) == 1:
+        return [first]
     sharding = jax.tree.leaves(state_like)[0].sharding
-    return jax.tree.map(
+    done_like = jax.tree.map(
         lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=sharding, weak_type=getattr(x, "weak_type", False)),
         first.out_info[1],
     )
+    return [first, jax.jit(fns[1]).trace(state_like, hyper_like, done_like)]
+
+
+def largest(traced: list[jax.stages.Traced]) -> int:
+    """Bytes of the largest set of values one operation of any part makes."""
+    return max(largest_value(t.jaxpr.jaxpr) for t in traced)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -61,21 +71,9 @@ class Chunk:
         return max(needs)
 
 
-def start(
-    fns: list[Callable],
-    first: jax.stages.Traced,
-    state_like,
-    hyper_like,
-    signals: Signals,
-    check: Callable[[jax.stages.Traced], None],
-) -> Callable[[], Chunk]:
-    """The chunk's compiles, begun: the first part's at once, each other part's once it is traced (beside
-    the first's compile) and ``check`` has seen its trace. Returns the function that waits for them (a
-    compile left running by an error or a signal ends with the process, as ``Signals.wait`` leaves its
-    threads)."""
-    compiling = [signals.begin(lambda: first.lower().compile())]
-    for fn in fns[1:]:
-        report = signals.wait(lambda fn=fn: jax.jit(fn).trace(state_like, hyper_like, done_like(first, state_like)))
-        check(report)
-        compiling.append(signals.begin(lambda r=report: r.lower().compile()))
-    return lambda: Chunk(tuple(signals.wait(c) for c in compiling))
+def compile_all(traced: list[jax.stages.Traced], signals: Signals) -> Chunk:
+    """Every part lowered and compiled at once, each in its own thread (a compile left running by an
+    error or a signal ends with the process, as ``Signals.wait`` leaves its threads)."""
+    pending = [signals.begin(lambda t=t: t.lower().compile()) for t in traced[1:]]
+    first = signals.wait(lambda: traced[0].lower().compile())
+    return Chunk((first, *(signals.wait(p) for p in pending)))

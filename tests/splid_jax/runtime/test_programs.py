@@ -26,12 +26,6 @@ def abstract(tree):
     return jax.tree.map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=x.sharding), tree)
 
 
-def compiled(learner, state, hyper, signals=None):
-    fns = programs.parts(learner, stacked=False)
-    first = jax.jit(fns[0]).trace(abstract(state), abstract(hyper))
-    return programs.start(fns, first, abstract(state), abstract(hyper), signals or Signals(), lambda _: None)()
-
-
 def two_chunks(learner, chunk):
     state, hyper, out = strong(learner.init(jax.random.PRNGKey(3))), strong(learner.hyper()), []
     for _ in range(2):
@@ -45,9 +39,10 @@ def test_training_and_report_as_two_programs_give_the_one_programs_chunk():
         Trainer(envs.make("point"), TrainConfig(**CFG)),
         HER(envs.make("point"), TrainConfig(**CFG, algo="her"), HerConfig(n_batches=4, batch_size=32)),
     ):
+        fns = programs.parts(learner, stacked=False)
+        assert len(fns) == 2
         state, hyper = strong(learner.init(jax.random.PRNGKey(3))), strong(learner.hyper())
-        split = compiled(learner, state, hyper)
-        assert len(split.programs) == 2
+        split = programs.compile_all(programs.trace(fns, abstract(state), abstract(hyper)), Signals())
         one, two = two_chunks(learner, jax.jit(learner.chunk)), two_chunks(learner, split)
         # to float rounding: under the suite's XLA:CPU flags the two modules fuse differently (without
         # them, and for the metrics here, bit for bit)
@@ -66,22 +61,9 @@ def test_the_two_programs_compile_at_once(monkeypatch):
     monkeypatch.setattr(jax.stages.Lowered, "compile", met)
     learner = Trainer(envs.make("point"), TrainConfig(**CFG))
     state, hyper = strong(learner.init(jax.random.PRNGKey(0))), strong(learner.hyper())
-    chunk = compiled(learner, state, hyper)
+    chunk = programs.compile_all(programs.trace(programs.parts(learner, False), abstract(state), abstract(hyper)),
+                                 Signals())  # fmt: skip
     assert len(chunk.programs) == 2 and chunk.bytes_needed() > 0
-
-
-def test_the_report_is_traced_while_the_training_compiles(monkeypatch):
-    lowering, seen, lower = threading.Event(), [], jax.stages.Traced.lower
-    monkeypatch.setattr(jax.stages.Traced, "lower", lambda self, *a, **kw: (lowering.set(), lower(self, *a, **kw))[1])
-
-    class Recorded(Trainer):
-        def report(self, state, hyper, done):  # traced once the training's compile has begun (at most 30 s)
-            seen.append(lowering.wait(30))
-            return super().report(state, hyper, done)
-
-    learner = Recorded(envs.make("point"), TrainConfig(**CFG))
-    compiled(learner, strong(learner.init(jax.random.PRNGKey(0))), strong(learner.hyper()))
-    assert seen == [True]
 
 
 def test_an_algorithm_with_a_chunk_alone_is_one_program():
@@ -91,6 +73,6 @@ def test_an_algorithm_with_a_chunk_alone_is_one_program():
 
     fns = programs.parts(Plain(), stacked=True)
     like = jax.ShapeDtypeStruct((3,), np.float32)
-    chunk = programs.start(fns, jax.jit(fns[0]).trace(like, like), like, like, Signals(), lambda _: None)()
+    chunk = programs.compile_all(programs.trace(fns, like, like), Signals())
     assert len(chunk.programs) == 1
     np.testing.assert_array_equal(chunk(np.ones(3, np.float32), np.ones(3, np.float32))[0], 2 * np.ones(3))
