@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import importlib
+import io
 
 from envs.base import GoalEnv, State
 from splid_jax.common.errors import InvalidConfig
@@ -30,7 +32,8 @@ def task_class(name: str) -> type[GoalEnv]:
     if name not in _REGISTRY:
         raise InvalidConfig("env", name, "one of " + ", ".join(_REGISTRY))
     module, cls_name = _REGISTRY[name].split(":")
-    return getattr(importlib.import_module(module), cls_name)
+    with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a notice on import when Warp is absent
+        return getattr(importlib.import_module(module), cls_name)
 
 
 def make(name: str, **overrides) -> GoalEnv:
