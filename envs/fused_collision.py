@@ -411,19 +411,19 @@ def kernel_plane_box(plane_pos, plane_mat, box_pos, box_mat, box_size, interpret
                    num_warps=num_warps)  # fmt: skip
 
 
-def _box_box_group(m, d, key, geom, kernel: bool):
+def _box_box_group(m, d, key, geom, kernel: bool, num_warps: int | None = None):
     """The collision driver's function for the box-box group: every pair's four contacts, pairs in order."""
     g1, g2 = geom.T
-    fn = kernel_box_box if kernel else box_box
+    fn = functools.partial(kernel_box_box, num_warps=num_warps) if kernel else box_box
     dist, pos, frame = jax.vmap(fn)(d.geom_xpos[g1], d.geom_xmat[g1], m.geom_size[g1], d.geom_xpos[g2],
                                     d.geom_xmat[g2], m.geom_size[g2])  # fmt: skip
     return dist.reshape(-1), pos.reshape(-1, 3), frame.reshape(-1, 3, 3)
 
 
-def _plane_box_group(m, d, key, geom, kernel: bool):
+def _plane_box_group(m, d, key, geom, kernel: bool, num_warps: int | None = None):
     """The collision driver's function for the plane-box group."""
     g1, g2 = geom.T
-    fn = kernel_plane_box if kernel else plane_box
+    fn = functools.partial(kernel_plane_box, num_warps=num_warps) if kernel else plane_box
     dist, pos, frame = jax.vmap(fn)(d.geom_xpos[g1], d.geom_xmat[g1], d.geom_xpos[g2], d.geom_xmat[g2],
                                     m.geom_size[g2])  # fmt: skip
     return dist.reshape(-1), pos.reshape(-1, 3), frame.reshape(-1, 3, 3)
@@ -441,9 +441,10 @@ def _limited(group, mjx_group, max_envs: int):
 
 
 @contextlib.contextmanager
-def fused_in_mjx(enabled: bool = True, kernel: bool = False, max_envs: int = 0):
+def fused_in_mjx(enabled: bool = True, kernel: bool = False, max_envs: int = 0, num_warps: int | None = None):
     """Within the block, MJX's collision driver collides planes with boxes and boxes with boxes through
-    ``plane_box`` and ``box_box`` (as Pallas kernels if ``kernel``, at batches up to ``max_envs`` if not 0). The
+    ``plane_box`` and ``box_box`` (as Pallas kernels of ``num_warps`` warps per pair if ``kernel``, at batches up
+    to ``max_envs`` if not 0). The
     driver looks its functions up when its code runs, which under ``jit`` is trace time only."""
     if not enabled:
         yield
@@ -456,7 +457,7 @@ def fused_in_mjx(enabled: bool = True, kernel: bool = False, max_envs: int = 0):
     with TRACE_LOCK:
         saved = {key: table[key] for key in groups}
         for key, group in groups.items():
-            fn = functools.partial(group, kernel=kernel)
+            fn = functools.partial(group, kernel=kernel, num_warps=num_warps)
             table[key] = _limited(fn, saved[key], max_envs) if kernel and max_envs else fn
             table[key].ncon = 4
         try:

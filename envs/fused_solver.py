@@ -285,16 +285,16 @@ _MJX_SOLVE = mjx_solver.solve
 
 
 @contextlib.contextmanager
-def fused_in_mjx(enabled: bool = True, kernel: bool = False, max_envs: int = 0):
-    """Within the block, MJX's forward dynamics solve through ``solve`` (as a Pallas kernel if ``kernel``, at
-    batches up to ``max_envs`` if not 0). MJX looks ``solver.solve`` up when its code runs, which under ``jit``
-    is trace time only."""
+def fused_in_mjx(enabled: bool = True, kernel: bool = False, max_envs: int = 0, num_warps: int | None = None):
+    """Within the block, MJX's forward dynamics solve through ``solve`` (as a Pallas kernel of ``num_warps`` warps
+    per env if ``kernel``, at batches up to ``max_envs`` if not 0). MJX looks ``solver.solve`` up when its code
+    runs, which under ``jit`` is trace time only."""
     if not enabled:
         yield
         return
 
     def fused_solve(m, d):  # MJX's named scope takes this name: profiles file the kernel under it
-        return solve(m, d, kernel, max_envs=max_envs)
+        return solve(m, d, kernel, num_warps=num_warps, max_envs=max_envs)
 
     with TRACE_LOCK:
         mjx_solver.solve = fused_solve

@@ -127,10 +127,7 @@ def her_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int
 
     rows["store_and_normalise"], state = timed(jax.jit(store_fn), state, episodes, valid, key, repeats=repeats)
 
-    def updates_fn(hs, key):
-        return jax.lax.scan(algo.train_step, hs, jax.random.split(key, algo.her.n_batches))
-
-    rows["updates"], _ = timed(jax.jit(updates_fn), state, key, repeats=repeats)
+    rows["updates"], _ = timed(jax.jit(algo.updates), state, key, repeats=repeats)
     rows["updates"]["steps"] = algo.her.n_batches
 
     def eval_fn(pstate, key):

@@ -47,6 +47,7 @@ CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linal
 # the whole solve as one program per env (envs/fused_solver.py), always or on a GPU only
 SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused", "gpu-fused")
 COLLISION = ("mjx", "fused", "gpu-fused")  # plane-box and box-box contacts: MJX's, or envs/fused_collision.py's
+KERNEL_WARPS = (1, 2, 4, 8)  # a Triton program's warps are a power of two
 KERNELS = ("fused", "gpu-fused")  # the choices above that run a part of the physics as a Pallas kernel
 
 
@@ -128,6 +129,9 @@ class _FetchTask(GoalEnv):
     # plane-box and box-box contacts as MJX computes them, or as one program per pair, a Pallas kernel on a GPU
     # (fused; on a GPU only: gpu-fused; envs/fused_collision.py): the same contacts up to MJX's float ties
     collision: str = experimental("mjx", numerics_only=True)
+    # GPU warps per env in the physics kernels above (Triton's default is 4): an env's solve is a chain of small
+    # reductions, which one warp runs without crossing warps (BENCHMARKS.md, "The solve kernel's warps")
+    kernel_warps: int = experimental(1, numerics_only=True)
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
     # how the gripper follows its target: the PD drive, or the reference's weld law (models.mjcf)
@@ -175,6 +179,8 @@ class _FetchTask(GoalEnv):
         ok = self.solver_loops in SOLVER_LOOPS
         check(ok, f"{n}.solver_loops", self.solver_loops, "one of " + ", ".join(SOLVER_LOOPS))
         check_integer(f"{n}.kernel_envs", self.kernel_envs, 0)
+        ok = self.kernel_warps in KERNEL_WARPS
+        check(ok, f"{n}.kernel_warps", self.kernel_warps, "one of " + ", ".join(map(str, KERNEL_WARPS)))
         ok = self.collision in COLLISION
         check(ok, f"{n}.collision", self.collision, "one of " + ", ".join(COLLISION))
         grasp_range = "in [0, 1]" if not self.block_gripper else "0 (the fingers are locked on this task)"
@@ -371,7 +377,8 @@ class _FetchTask(GoalEnv):
     @contextlib.contextmanager
     def solver_in_mjx(self):
         """Within the block (a trace of MJX calls), MJX factors, solves and collides boxes as this task's
-        ``cholesky``, ``solver_loops`` and ``collision`` choose (the kernels up to ``kernel_envs`` envs), on the
+        ``cholesky``, ``solver_loops`` and ``collision`` choose (the kernels up to ``kernel_envs`` envs, with
+        ``kernel_warps`` warps per env), on the
         backend being traced for."""
         backend = jax.default_backend()
         newton, line_search = solver_loops.writes_out(self.solver_loops, backend)
@@ -379,10 +386,16 @@ class _FetchTask(GoalEnv):
             small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"),
             solver_loops.unrolled_in_mjx(self.iterations, newton, line_search),
             fused_solver.fused_in_mjx(
-                runs_as_kernel(self.solver_loops, backend), kernel=backend == "gpu", max_envs=self.kernel_envs
+                runs_as_kernel(self.solver_loops, backend),
+                kernel=backend == "gpu",
+                max_envs=self.kernel_envs,
+                num_warps=self.kernel_warps,
             ),
             fused_collision.fused_in_mjx(
-                runs_as_kernel(self.collision, backend), kernel=backend == "gpu", max_envs=self.kernel_envs
+                runs_as_kernel(self.collision, backend),
+                kernel=backend == "gpu",
+                max_envs=self.kernel_envs,
+                num_warps=self.kernel_warps,
             ),
         ):
             yield

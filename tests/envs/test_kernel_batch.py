@@ -50,3 +50,24 @@ def test_no_limit_keeps_the_kernel_function_itself():
     np.testing.assert_array_equal(jax.vmap(limited)(jnp.ones(2)), [2.0, 2.0])
     np.testing.assert_array_equal(jax.vmap(limited)(jnp.ones(3)), [0.0, 0.0, 0.0])
     np.testing.assert_array_equal(jax.vmap(jax.vmap(limited))(jnp.ones((3, 2))), np.full((3, 2), 2.0))
+
+
+def test_every_physics_kernel_takes_the_tasks_warps(monkeypatch):
+    # one warp per env is the faster kernel at every batch measured (BENCHMARKS.md); 4 is Triton's default
+    from jax.experimental.pallas import triton as pl_triton
+
+    made = []
+    params = pl_triton.CompilerParams
+
+    def recorded(*args, **kwargs):
+        made.append(kwargs.get("num_warps"))
+        return params(*args, **kwargs)
+
+    monkeypatch.setattr(pl_triton, "CompilerParams", recorded)
+    for warps in (None, 4):
+        made.clear()
+        env = envs.make("push", substeps=1) if warps is None else envs.make("push", substeps=1, kernel_warps=warps)
+        assert triton_calls_for_gpu(env, monkeypatch, (8,)) == 3  # the two contact groups and the solve
+        assert made == [1 if warps is None else warps] * 3
+    with pytest.raises(InvalidConfig, match="kernel_warps"):
+        envs.make("push", kernel_warps=3)

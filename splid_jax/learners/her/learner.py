@@ -149,37 +149,38 @@ class HER(Chunked):
         stats = running_statistics.update(pstate.normaliser, x, weights=w, std_min_value=self.her.norm_eps)
         return pstate.replace(normaliser=stats)
 
-    def losses(self, actor, critic, pstate: PolicyState, target_actor, target_critic, tr: Transitions):
-        """Critic: squared error to the clipped TD target; actor: -Q(s, pi(s)) + action_l2 * pi^2."""
-        her = self.her
+    def _q(self, params, x: jax.Array, a: jax.Array) -> jax.Array:
+        return self.critic.apply(params, jnp.concatenate([x, a], axis=-1))[..., 0]
+
+    def td_targets(self, hs: HerState, tr: Transitions) -> jax.Array:
+        """The clipped TD targets of ``tr`` (any leading axes). The target networks and the normaliser stay
+        fixed over a cycle's updates (Baselines moves the targets after them), so every batch's targets come
+        from one pass before the updates rather than two small networks' passes in each."""
+        x_next = self._inputs(hs.policy.normaliser, tr.next_obs, tr.goal)
+        next_q = self._q(hs.target_critic, x_next, self.policy.net.apply(hs.target_actor, x_next))
+        return td_target(tr.reward, next_q, self.her.gamma, *self.target_range)
+
+    def losses(self, actor, critic, pstate: PolicyState, tr: Transitions, target: jax.Array):
+        """Critic: squared error to the clipped TD ``target``; actor: -Q(s, pi(s)) + action_l2 * pi^2."""
         x = self._inputs(pstate.normaliser, tr.obs, tr.goal)
-        x_next = self._inputs(pstate.normaliser, tr.next_obs, tr.goal)
-
-        def q(params, x, a):
-            return self.critic.apply(params, jnp.concatenate([x, a], axis=-1))[..., 0]
-
-        next_q = q(target_critic, x_next, self.policy.net.apply(target_actor, x_next))
-        target = jax.lax.stop_gradient(td_target(tr.reward, next_q, her.gamma, *self.target_range))
 
         def critic_loss(params):
-            q_data = q(params, x, tr.action)
+            q_data = self._q(params, x, tr.action)
             return jnp.mean((target - q_data) ** 2), q_data
 
         def actor_loss(params):
             pi = self.policy.net.apply(params, x)
-            return -jnp.mean(q(critic, x, pi)) + her.action_l2 * jnp.mean(pi**2)
+            return -jnp.mean(self._q(critic, x, pi)) + self.her.action_l2 * jnp.mean(pi**2)
 
         (c_loss, q_data), c_grad = jax.value_and_grad(critic_loss, has_aux=True)(critic)
         a_loss, a_grad = jax.value_and_grad(actor_loss)(actor)
         return c_loss, a_loss, jnp.mean(q_data), c_grad, a_grad
 
-    def train_step(self, hs: HerState, key: jax.Array) -> tuple[HerState, dict]:
+    def train_step(self, hs: HerState, batch: tuple[Transitions, jax.Array]) -> tuple[HerState, dict]:
         """One gradient step of critic and actor, both from the same batch at the same parameters (as
         Baselines computes them in one pass)."""
-        tr = sample_transitions(hs.buffer, key, self.her.batch_size, self.her.future_p, self.env.reward_of)
-        c_loss, a_loss, q_mean, c_grad, a_grad = self.losses(
-            hs.policy.params, hs.critic, hs.policy, hs.target_actor, hs.target_critic, tr
-        )
+        tr, target = batch
+        c_loss, a_loss, q_mean, c_grad, a_grad = self.losses(hs.policy.params, hs.critic, hs.policy, tr, target)
         filled = (hs.buffer.size > 0).astype(jnp.float32)  # no step on an empty buffer
         c_grad, a_grad = jax.tree_util.tree_map(lambda g: g * filled, (c_grad, a_grad))
         c_upd, critic_opt = self.critic_opt.update(c_grad, hs.critic_opt, hs.critic)
@@ -192,6 +193,18 @@ class HER(Chunked):
         )
         return hs, {"critic_loss": c_loss, "actor_loss": a_loss, "q_mean": q_mean}
 
+    def updates(self, hs: HerState, key: jax.Array) -> tuple[HerState, dict]:
+        """A cycle's ``n_batches`` gradient steps. The buffer does not change between them, so their batches
+        are drawn at once (each from its own key, as one at a time would draw it) with their TD targets, and
+        the scan carries only the steps."""
+        her = self.her
+
+        def draw(k):
+            return sample_transitions(hs.buffer, k, her.batch_size, her.future_p, self.env.reward_of)
+
+        batches = jax.vmap(draw)(jax.random.split(key, her.n_batches))
+        return jax.lax.scan(self.train_step, hs, (batches, self.td_targets(hs, batches)))
+
     def iteration(self, hs: HerState, hyper) -> tuple[HerState, dict]:
         """One Baselines cycle."""
         key, k_explore, k_norm, k_train = jax.random.split(hs.key, 4)
@@ -200,7 +213,7 @@ class HER(Chunked):
             buffer=buffer_insert(hs.buffer, episodes, valid),
             policy=self.update_normaliser(hs.policy, episodes, valid, k_norm),
         )
-        hs, losses = jax.lax.scan(self.train_step, hs, jax.random.split(k_train, self.her.n_batches))
+        hs, losses = self.updates(hs, k_train)
         step = 1.0 - self.her.polyak
         hs = hs.replace(
             target_actor=optax.incremental_update(hs.policy.params, hs.target_actor, step),

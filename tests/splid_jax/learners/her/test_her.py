@@ -118,6 +118,28 @@ def test_target_is_clipped_to_the_returns_the_sparse_reward_allows():
     np.testing.assert_allclose(her_mod.td_target(r, q, 0.98, -50.0, 0.0), [-50.0, -10.8, 0.0, -2.94], rtol=1e-6)
 
 
+def test_updates_drawn_at_once_are_the_updates_drawn_one_at_a_time(her, learned):
+    # a cycle's batches and TD targets come before its scan of steps: as if each step drew its own batch from
+    # its own key and took its targets from the (fixed) target networks
+    state = learned[0][0]
+    key = jax.random.PRNGKey(5)
+    at_once, losses = jax.jit(her.updates)(state, key)
+    h, cfg = state, her.her
+
+    @jax.jit
+    def one(h, k):
+        tr = episode_buffer.sample_transitions(h.buffer, k, cfg.batch_size, cfg.future_p, her.env.reward_of)
+        return her.train_step(h, (tr, her.td_targets(h, tr)))
+
+    steps = []
+    for k in jax.random.split(key, cfg.n_batches):
+        h, step_losses = one(h, k)
+        steps.append(float(step_losses["critic_loss"]))
+    np.testing.assert_allclose(losses["critic_loss"], steps, rtol=1e-5)
+    for a, b in zip(jax.tree_util.tree_leaves(at_once), jax.tree_util.tree_leaves(h), strict=True):
+        np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-6)
+
+
 def test_buffer_keeps_only_valid_episodes_first_in_first_out():
     buf = episode_buffer.buffer_init(3, 2, 1, 1, 1)
     new = episode_buffer.buffer_init(4, 2, 1, 1, 1)
