@@ -9,10 +9,11 @@ training; OUT/figure.json records the command, the device and the date.
 
 The modules, one job each: ``registry`` (the figures and methods), ``settings`` (``--methods``,
 ``--values``, ``--set``), ``planning`` (each method's sweep for the budget), ``record`` (OUT/figure.json
-and the sweeps' directories), ``runs`` (training), ``merging`` (parts trained apart), ``series``
-(statistics over seeds, from ``splid_jax.common.stats``), ``table`` (the CSV), ``drawing`` (the PNG) and
-``cli``. Their public names are reachable from this package too; they load on first use, so that
-``python -m splid_jax.figures`` can set its signal handlers before JAX loads."""
+and the sweeps' directories), ``runs`` (training), ``side_by_side`` (the methods at once, one process
+each), ``merging`` (parts trained apart), ``series`` (statistics over seeds, from
+``splid_jax.common.stats``), ``table`` (the CSV), ``drawing`` (the PNG) and ``cli``. Their public names are
+reachable from this package too; they load on first use, so that ``python -m splid_jax.figures`` can set
+its signal handlers before JAX loads."""
 
 from __future__ import annotations
 
@@ -33,7 +34,8 @@ _HOMES = {
         "plan",
     ),
     "splid_jax.figures.record": ("SPEC", "check_out", "load_record", "sweeps"),
-    "splid_jax.figures.runs": ("train",),
+    "splid_jax.figures.runs": ("train", "train_sweep"),
+    "splid_jax.figures.side_by_side": ("mps_running", "train_side_by_side"),
     "splid_jax.figures.merging": ("merge",),
     "splid_jax.figures.series": ("MEASURES", "Series", "load_series"),
     "splid_jax.figures.table": ("write_csv",),

@@ -21,6 +21,7 @@ from splid_jax.figures.record import check_out, load_record
 from splid_jax.figures.registry import METHODS, SPECS
 from splid_jax.figures.runs import train
 from splid_jax.figures.settings import parse_methods, parse_sets, parse_values
+from splid_jax.figures.side_by_side import train_side_by_side
 from splid_jax.runtime import checkpoint, lock, loop, progress
 
 HELP = """\
@@ -41,6 +42,8 @@ CSV (method, episodes, mean and standard error of each measure, seeds, wall-cloc
 without compilation, iterations and episodes each method ran) lie in OUT.
 A figure too long for one machine or call can be trained as --methods (fig3) or --values (fig4, fig5)
 subsets, each in its own --out, and joined with --merge (figN --merge DIR1 DIR2 ... --out OUT).
+fig3 --side-by-side trains its methods at once, one process each: on a GPU under CUDA MPS
+(nvidia-cuda-mps-control -d) they share it, where in turn their times add up.
 Exit codes: 0 done, 2 bad input (nothing trained), 3 a run stopped (NaN), 130 Ctrl-C, 143 SIGTERM
 (each method's newest state is kept; --resume continues)."""
 
@@ -108,6 +111,12 @@ def build_parser() -> Parser:
         help="with fig3's --merge: a method in several parts is taken from the last of them (a method run "
         "again, joined with an earlier merged figure)",
     )
+    parser.add_argument(
+        "--side-by-side",
+        action="store_true",
+        help="fig3: train the methods at once, one process each, their output in OUT/logs/ (on a GPU, under "
+        "CUDA MPS: nvidia-cuda-mps-control -d; without it a GPU runs one process at a time, no faster than in turn)",
+    )
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_compile_cache_flag(parser)
     return parser
@@ -126,9 +135,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         else os.path.join("experiments", "results", today, f"{ns.figure}-{env_name}")
     )
     use_compile_cache(ns.compile_cache)
+    if ns.side_by_side:  # the children share the GPU: this process must not take most of its memory first
+        os.environ.setdefault("XLA_PYTHON_CLIENT_PREALLOCATE", "false")
     try:
         with lock.hold(out, field="out"):  # one process per figure directory
             check(bool(ns.merge) or not ns.replace, "replace", True, "given with --merge")
+            side = ns.side_by_side
+            check(not side or ns.figure == "fig3", "side_by_side", True, "given for fig3 (one process per method)")
+            training = not (ns.merge or ns.replot)
+            check(not side or training, "side_by_side", True, "given to train (not with --merge or --replot)")
             if ns.merge:
                 check(not (ns.replot or ns.resume), "merge", " ".join(ns.merge), "given without --replot or --resume")
                 check(ns.out is not None, "out", None, "the new directory --merge joins the parts into")
@@ -138,9 +153,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                 mode = "resume" if ns.resume else "replot"
                 record = check_unchanged(ns, load_record(out, mode), out, mode)
                 if ns.resume:
-                    train(out, record, ns.quiet, resume=True)
+                    trained(side)(out, record, ns.quiet, resume=True, compile_cache=ns.compile_cache)
             else:
-                train(out, new_record(ns, spec, env_name, out, today, argv), ns.quiet)
+                record = new_record(ns, spec, env_name, out, today, argv)
+                trained(side)(out, record, ns.quiet, compile_cache=ns.compile_cache)
             png, table = render(out, ns.quiet)
     except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
@@ -158,6 +174,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 3
     progress.show(f"figure: {png}\ntable: {table}", ns.quiet)
     return 0
+
+
+def trained(side_by_side: bool):
+    """How a figure's methods are trained: in turn in this process, or at once, one process each."""
+    if side_by_side:
+        return train_side_by_side
+    return lambda out, record, quiet, resume=False, compile_cache="": train(out, record, quiet, resume)
 
 
 def new_record(ns: argparse.Namespace, spec, env_name: str, out: str, today: str, argv: list[str]) -> dict:

@@ -15,20 +15,25 @@ def train(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
     OUT/figure.json the seconds each took over every call, a stopped one's included."""
     loop.write_json(os.path.join(out, SPEC), record)
     for method, ran, sub in sweeps(record):
-        run_dir = os.path.join(out, sub)
-        base = TrainConfig.from_json({**ran["config"], "run_dir": run_dir})
-        lanes = [TrainConfig.from_json({**m, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in ran["members"]]
-        again = resume and os.path.isdir(run_dir) and checkpoint.latest_step(run_dir) is not None
-        progress.show(
-            f"{record['figure']} {method}: {len(lanes)} members, {base.iterations} iterations x "
-            f"{ran['episodes_per_iteration']} episodes = {ran['episodes']:,} episodes "
-            f"(budget {record['budget_episodes']:,})" + (", resumed" if again else ""),
-            quiet,
-        )
         t0 = time.perf_counter()
         try:
-            env = loop.make_env(base.env, **base.env_overrides())
-            loop.run(base, env, members=lanes, resume=again, quiet=quiet)
+            train_sweep(out, record, method, ran, sub, quiet, resume)
         finally:  # a stopped method's seconds count too, so a resumed figure's total is whole
             ran["total_s"] = round(ran.get("total_s", 0.0) + time.perf_counter() - t0, 1)  # compilation included
             loop.write_json(os.path.join(out, SPEC), record)
+
+
+def train_sweep(out: str, record: dict, method: str, ran: dict, sub: str, quiet: bool, resume: bool) -> None:
+    """One method's sweep in OUT/``sub`` (on ``resume`` from its checkpoint, if it has one)."""
+    run_dir = os.path.join(out, sub)
+    base = TrainConfig.from_json({**ran["config"], "run_dir": run_dir})
+    lanes = [TrainConfig.from_json({**m, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in ran["members"]]
+    again = resume and os.path.isdir(run_dir) and checkpoint.latest_step(run_dir) is not None
+    progress.show(
+        f"{record['figure']} {method}: {len(lanes)} members, {base.iterations} iterations x "
+        f"{ran['episodes_per_iteration']} episodes = {ran['episodes']:,} episodes "
+        f"(budget {record['budget_episodes']:,})" + (", resumed" if again else ""),
+        quiet,
+    )
+    env = loop.make_env(base.env, **base.env_overrides())
+    loop.run(base, env, members=lanes, resume=again, quiet=quiet)

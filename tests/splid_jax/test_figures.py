@@ -59,6 +59,29 @@ def test_quick_fig3_writes_a_figure_and_a_table_with_equal_budgets(fig3):
 
 
 @pytest.mark.slow
+def test_methods_side_by_side_learn_what_they_learn_in_turn(fig3, tmp_path):
+    # one child process per method, each training its sweep as the figure in turn does (the fixture's)
+    out = tmp_path / "side"
+    args = ["fig3", "--methods", "gcsl,no-select", "--side-by-side", "--out", str(out), *QUICK]
+    assert figures.main(args) == 0
+    measures = ("episodes", "eval_success_mean", "eval_success_final_mean", "eval_return_mean")
+    in_turn = {(r["method"], r["episodes"]): r for r in rows(fig3[1] / "fig3-point.csv")}
+    side = rows(out / "fig3-point.csv")
+    assert {r["method"] for r in side} == {"gcsl", "no-select"}
+    for r in side:
+        ref = in_turn[(r["method"], r["episodes"])]
+        np.testing.assert_allclose([float(r[k]) for k in measures], [float(ref[k]) for k in measures], atol=1e-6)
+    assert sorted(p.name for p in (out / "logs").iterdir()) == ["gcsl.log", "no-select.log"]
+    assert all(run["total_s"] > 0 for run in json.loads((out / "figure.json").read_text())["runs"].values())
+
+
+@pytest.mark.parametrize("args", [["fig4", "--side-by-side"], ["fig3", "--side-by-side", "--replot"]])
+def test_side_by_side_is_for_training_fig3(tmp_path, capsys, args):
+    assert figures.main([*args, "--out", str(tmp_path / "x"), "--quiet"]) == 2
+    assert "side_by_side" in capsys.readouterr().err
+
+
+@pytest.mark.slow
 def test_replot_redraws_from_the_run_dirs_without_training(fig3, monkeypatch):
     code, out = fig3
     assert code == 0

@@ -1,0 +1,152 @@
+"""Training a figure's methods at once, one process each (``python -m splid_jax.figures fig3 --side-by-side``).
+
+Why: at the sizes the methods run (16 to 640 envs) each program is a chain of small kernels that leaves most of a
+GPU idle. Under CUDA MPS the processes' kernels run on the GPU together: Figure 3's six methods on Push at 100,000
+episodes shared one H100 so, where in turn they add up (BENCHMARKS.md, "Baselines"). Without MPS a GPU runs one
+process's kernels at a time, and side by side takes as long as in turn.
+
+The parent starts one child per method (``python -m splid_jax.figures.side_by_side OUT METHOD``), each training
+its sweep as ``runs.train`` would, its output in OUT/logs/METHOD.log; only the parent writes OUT/figure.json. The
+children have sessions of their own, so a terminal's Ctrl-C reaches the parent alone, which passes each SIGINT or
+SIGTERM on once: every child checkpoints and stops, and ``--resume`` continues them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import subprocess
+import sys
+import time
+
+from splid_jax.figures.record import SPEC, load_record, sweeps
+from splid_jax.figures.runs import train_sweep
+from splid_jax.runtime import checkpoint, loop, progress
+
+LOGS = "logs"
+POLL_S = 0.5
+REPORT_S = 30.0  # seconds between progress lines
+MPS_PIPE = "/tmp/nvidia-mps"  # where CUDA MPS's control daemon listens unless CUDA_MPS_PIPE_DIRECTORY says otherwise
+
+
+def mps_running() -> bool:
+    """Whether a CUDA MPS control daemon seems to listen (its pipe directory holds its control pipe)."""
+    return os.path.exists(os.path.join(os.environ.get("CUDA_MPS_PIPE_DIRECTORY", MPS_PIPE), "control"))
+
+
+def _on_gpu() -> bool:
+    import jax
+
+    return jax.default_backend() == "gpu"
+
+
+def child_command(out: str, method: str, resume: bool, compile_cache: str) -> list[str]:
+    return [sys.executable, "-m", __name__, out, method, "--compile-cache", compile_cache] + (
+        ["--resume"] if resume else []
+    )
+
+
+def _latest_iteration(out: str, sub: str, ran: dict) -> int | None:
+    """The first member's newest recorded iteration, read from the end of its metrics file."""
+    path = os.path.join(out, sub, ran["members"][0]["run_dir"], "metrics.jsonl")
+    try:
+        with open(path, "rb") as fh:
+            fh.seek(max(0, os.path.getsize(path) - 4096))
+            last = fh.read().decode(errors="replace").strip().splitlines()[-1]
+        return int(last.split('"iteration": ', 1)[1].split(",", 1)[0])
+    except (OSError, IndexError, ValueError):
+        return None
+
+
+def train_side_by_side(out: str, record: dict, quiet: bool, resume: bool = False, compile_cache: str = "") -> None:
+    """Trains every sweep of ``record`` at once, one child process each, and notes each one's seconds in
+    OUT/figure.json as it ends. Raises ``loop.Interrupted`` after passing a signal on (the children have
+    checkpointed), ``loop.RunStopped`` naming the methods whose process failed and their logs."""
+    loop.write_json(os.path.join(out, SPEC), record)  # what each child reads
+    logs = os.path.join(out, LOGS)
+    os.makedirs(logs, exist_ok=True)
+    env = {**os.environ, "XLA_PYTHON_CLIENT_PREALLOCATE": os.environ.get("XLA_PYTHON_CLIENT_PREALLOCATE", "false")}
+    jobs = []
+    for method, ran, sub in sweeps(record):
+        with open(os.path.join(logs, f"{method}.log"), "a") as log:  # the child holds its own copy of the file
+            cmd = child_command(out, method, resume, compile_cache)
+            proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env, start_new_session=True)
+        jobs.append((method, ran, sub, proc, time.perf_counter()))
+    progress.show(f"{record['figure']}: {len(jobs)} methods side by side, their output in {logs}", quiet)
+    if not mps_running() and _on_gpu():
+        print(
+            "warning: no CUDA MPS daemon found (nvidia-cuda-mps-control -d): the GPU runs one process's kernels "
+            "at a time, and side by side takes as long as in turn",
+            file=sys.stderr,
+        )
+    caught: list[int] = []
+
+    def pass_on(signum, frame):
+        caught.append(signum)
+        for _, _, _, proc, _ in jobs:
+            if proc.poll() is None:
+                proc.send_signal(signum)
+
+    previous = {sig: signal.signal(sig, pass_on) for sig in (signal.SIGINT, signal.SIGTERM)}
+    running, t0, reported = list(jobs), time.perf_counter(), time.perf_counter()
+    try:
+        while running:
+            time.sleep(POLL_S)
+            for job in [j for j in running if j[3].poll() is not None]:
+                running.remove(job)
+                _, ran, _, _, start = job
+                ran["total_s"] = round(ran.get("total_s", 0.0) + time.perf_counter() - start, 1)
+                loop.write_json(os.path.join(out, SPEC), record)
+            if running and time.perf_counter() - reported >= REPORT_S:
+                reported = time.perf_counter()
+                states = [
+                    f"{m} {'ended' if p.poll() is not None else _latest_iteration(out, s, r) or 0}"
+                    + ("" if p.poll() is not None else f"/{r['config']['iterations']}")
+                    for m, r, s, p, _ in jobs
+                ]
+                elapsed = time.perf_counter() - t0
+                progress.show(f"{record['figure']} side by side, {elapsed:.0f} s: " + ", ".join(states), quiet)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        for _, _, _, proc, _ in running:  # an error here: the children stop with it, checkpointed
+            proc.send_signal(signal.SIGTERM)
+            proc.wait()
+    if caught:
+        raise loop.Interrupted(caught[0])
+    failed = [(m, p.returncode) for m, _, _, p, _ in jobs if p.returncode != 0]
+    if failed:
+        named = ", ".join(f"{m} (exit {rc}, {os.path.join(logs, m + '.log')})" for m, rc in failed)
+        raise loop.RunStopped(f"{len(failed)} of {len(jobs)} methods failed: {named}; the others finished")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """One child: trains METHOD's sweep of the figure in OUT, as the parent's record describes it."""
+    parser = argparse.ArgumentParser(prog=f"python -m {__name__}")
+    parser.add_argument("out")
+    parser.add_argument("method")
+    parser.add_argument("--resume", action="store_true")
+    parser.add_argument("--compile-cache", default="")
+    ns = parser.parse_args(argv)
+    from splid_jax.cli import use_compile_cache
+
+    use_compile_cache(ns.compile_cache)
+    record = load_record(ns.out)
+    found = [(m, ran, sub) for m, ran, sub in sweeps(record) if m == ns.method]
+    if not found:
+        print(f"{parser.prog}: error: no method {ns.method!r} in {ns.out}", file=sys.stderr)
+        return 2
+    try:
+        for method, ran, sub in found:
+            train_sweep(ns.out, record, method, ran, sub, quiet=False, resume=ns.resume)  # the log shows progress
+    except loop.Interrupted as stop:
+        return stop.exit_code
+    except (loop.RunStopped, checkpoint.CheckpointError) as err:
+        print(f"{parser.prog}: error: {err}", file=sys.stderr)
+        return 3
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

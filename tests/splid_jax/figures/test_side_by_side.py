@@ -1,0 +1,95 @@
+"""A figure's methods side by side: one child process each, the parent alone writing figure.json, a failed
+child named with its log, and a signal passed on once to every child (the training itself: test_figures.py)."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import sys
+import threading
+import time
+
+import pytest
+
+from splid_jax.figures import side_by_side
+from splid_jax.runtime import loop
+
+# a stand-in child: notes that it started, then exits with its method's code, or on SIGTERM notes the signal
+CHILD = """
+import os, signal, sys, time
+out, method = sys.argv[1], sys.argv[2]
+def stop(signum, frame):
+    open(os.path.join(out, method + ".signals"), "a").write(str(signum) + "\\n")
+    sys.exit(128 + signum)
+signal.signal(signal.SIGTERM, stop)
+print("training", method, flush=True)
+open(os.path.join(out, method + ".started"), "w").close()
+code = {"ok": 0, "bad": 3}.get(method)
+if code is None:
+    time.sleep(60)
+sys.exit(code)
+"""
+
+
+def record_of(methods):
+    runs = {m: {"config": {"iterations": 10}, "members": [{"run_dir": "s0"}]} for m in methods}
+    return {"figure": "fig3", "methods": list(methods), "runs": runs}
+
+
+@pytest.fixture
+def stand_in(monkeypatch):
+    def command(out, method, resume, cache):
+        return [sys.executable, "-c", CHILD, out, method]
+
+    monkeypatch.setattr(side_by_side, "child_command", command)
+
+
+def test_a_failed_method_is_named_with_its_log_and_the_others_seconds_are_kept(tmp_path, stand_in):
+    out = str(tmp_path)
+    record = record_of(["ok", "bad"])
+    with pytest.raises(loop.RunStopped, match=r"1 of 2 methods failed: bad \(exit 3, .*bad\.log\)"):
+        side_by_side.train_side_by_side(out, record, quiet=True, resume=False)
+    written = json.loads((tmp_path / "figure.json").read_text())  # only the parent writes it
+    assert set(written["runs"]) == {"ok", "bad"} and all(r["total_s"] >= 0 for r in written["runs"].values())
+    assert (tmp_path / "logs" / "ok.log").read_text() == "training ok\n"
+
+
+def test_a_signal_is_passed_on_once_to_every_child_and_stops_the_figure(tmp_path, stand_in):
+    out = str(tmp_path)
+    record = record_of(["slow1", "slow2"])
+    default = signal.getsignal(signal.SIGTERM)
+
+    def send_when_ready():  # once the parent passes signals on and both children listen for them
+        deadline = time.monotonic() + 30
+        started = [os.path.join(out, f"slow{i}.started") for i in (1, 2)]
+        while time.monotonic() < deadline:
+            if signal.getsignal(signal.SIGTERM) is not default and all(map(os.path.exists, started)):
+                os.kill(os.getpid(), signal.SIGTERM)
+                return
+            time.sleep(0.05)
+
+    sender = threading.Thread(target=send_when_ready)
+    sender.start()
+    with pytest.raises(loop.Interrupted) as stopped:
+        side_by_side.train_side_by_side(out, record, quiet=True, resume=False)
+    sender.join()
+    assert stopped.value.exit_code == 143
+    for child in ("slow1", "slow2"):
+        assert (tmp_path / f"{child}.signals").read_text() == f"{int(signal.SIGTERM)}\n"
+    assert signal.getsignal(signal.SIGTERM) is default  # the parent's handlers are restored
+
+
+def test_children_get_the_compile_cache_the_resume_and_the_gpu_shared(tmp_path, monkeypatch):
+    cmd = side_by_side.child_command("OUT", "her", True, "/cache")
+    assert cmd[1:] == ["-m", "splid_jax.figures.side_by_side", "OUT", "her", "--compile-cache", "/cache", "--resume"]
+    monkeypatch.setenv("CUDA_MPS_PIPE_DIRECTORY", str(tmp_path))
+    assert not side_by_side.mps_running()
+    (tmp_path / "control").touch()
+    assert side_by_side.mps_running()
+
+
+def test_a_child_asked_for_a_method_the_figure_lacks_is_one_line(tmp_path, capsys):
+    (tmp_path / "figure.json").write_text(json.dumps(record_of(["gcsl"])))
+    assert side_by_side.main([str(tmp_path), "her"]) == 2
+    assert capsys.readouterr().err.strip().endswith(f"no method 'her' in {tmp_path}")
