@@ -8,7 +8,8 @@ process's kernels at a time, and side by side takes as long as in turn.
 The parent starts one child per method (``python -m splid_jax.figures.side_by_side OUT METHOD``), each training
 its sweep as ``runs.train`` would, its output in OUT/logs/METHOD.log; only the parent writes OUT/figure.json. The
 children have sessions of their own, so a terminal's Ctrl-C reaches the parent alone, which passes each SIGINT or
-SIGTERM on once: every child checkpoints and stops, and ``--resume`` continues them.
+SIGTERM on once: every child checkpoints and stops, and ``--resume`` continues them. A child whose parent is gone
+stops so too.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 from splid_jax.figures.record import SPEC, load_record, sweeps
@@ -121,6 +123,20 @@ def train_side_by_side(out: str, record: dict, quiet: bool, resume: bool = False
         raise loop.RunStopped(f"{len(failed)} of {len(jobs)} methods failed: {named}; the others finished")
 
 
+def stop_when_orphaned(parent: int, every_s: float = 1.0) -> threading.Thread:
+    """Sends this process SIGTERM once ``parent`` is gone (killed, say, with SIGKILL, which it cannot pass on),
+    so a child checkpoints and stops rather than train on unwatched; ``--resume`` continues it."""
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(every_s)
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    thread = threading.Thread(target=watch, name="orphan-watch", daemon=True)
+    thread.start()
+    return thread
+
+
 def main(argv: list[str] | None = None) -> int:
     """One child: trains METHOD's sweep of the figure in OUT, as the parent's record describes it."""
     parser = argparse.ArgumentParser(prog=f"python -m {__name__}")
@@ -129,6 +145,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--resume", action="store_true")
     parser.add_argument("--compile-cache", default="")
     ns = parser.parse_args(argv)
+    stop_when_orphaned(os.getppid())
     from splid_jax.cli import use_compile_cache
 
     use_compile_cache(ns.compile_cache)

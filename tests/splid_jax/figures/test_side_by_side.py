@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import os
 import signal
+import subprocess
 import sys
 import threading
 import time
@@ -93,3 +94,26 @@ def test_a_child_asked_for_a_method_the_figure_lacks_is_one_line(tmp_path, capsy
     (tmp_path / "figure.json").write_text(json.dumps(record_of(["gcsl"])))
     assert side_by_side.main([str(tmp_path), "her"]) == 2
     assert capsys.readouterr().err.strip().endswith(f"no method 'her' in {tmp_path}")
+
+
+def test_a_child_whose_parent_is_gone_stops_itself(tmp_path):
+    # a parent killed outright cannot pass a signal on: its children then stop as if it had sent SIGTERM
+    marker = tmp_path / "stopped"
+    child = (
+        "import signal, sys, time\n"
+        "from splid_jax.figures.side_by_side import stop_when_orphaned\n"
+        f"signal.signal(signal.SIGTERM, lambda *a: (open({str(marker)!r}, 'w').write('15'), sys.exit(143)))\n"
+        "import os; stop_when_orphaned(os.getppid(), every_s=0.05)\n"
+        "print('watching', flush=True)\n"
+        "time.sleep(30)\n"
+    )
+    parent = (  # starts the child, waits until it watches, then exits without a word to it
+        "import subprocess, sys\n"
+        f"p = subprocess.Popen([sys.executable, '-c', {child!r}], stdout=subprocess.PIPE, start_new_session=True)\n"
+        "p.stdout.readline()\n"
+    )
+    subprocess.run([sys.executable, "-c", parent], check=True, timeout=60)
+    deadline = time.monotonic() + 20
+    while not marker.exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert marker.read_text() == "15"
