@@ -153,10 +153,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                 mode = "resume" if ns.resume else "replot"
                 record = check_unchanged(ns, load_record(out, mode), out, mode)
                 if ns.resume:
-                    trained(side)(out, record, ns.quiet, resume=True, compile_cache=ns.compile_cache)
+                    (train_side_by_side if side else train)(out, record, ns.quiet, resume=True)
             else:
                 record = new_record(ns, spec, env_name, out, today, argv)
-                trained(side)(out, record, ns.quiet, compile_cache=ns.compile_cache)
+                (train_side_by_side if side else train)(out, record, ns.quiet)
             png, table = render(out, ns.quiet)
     except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
@@ -174,13 +174,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 3
     progress.show(f"figure: {png}\ntable: {table}", ns.quiet)
     return 0
-
-
-def trained(side_by_side: bool):
-    """How a figure's methods are trained: in turn in this process, or at once, one process each."""
-    if side_by_side:
-        return train_side_by_side
-    return lambda out, record, quiet, resume=False, compile_cache="": train(out, record, quiet, resume)
 
 
 def new_record(ns: argparse.Namespace, spec, env_name: str, out: str, today: str, argv: list[str]) -> dict:

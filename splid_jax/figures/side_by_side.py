@@ -25,6 +25,7 @@ import time
 from splid_jax.figures.record import SPEC, load_record, sweeps
 from splid_jax.figures.runs import train_sweep
 from splid_jax.runtime import checkpoint, loop, progress
+from splid_jax.runtime.run_files import METRICS, read_metrics
 
 LOGS = "logs"
 POLL_S = 0.5
@@ -43,6 +44,12 @@ def _on_gpu() -> bool:
     return jax.default_backend() == "gpu"
 
 
+def _compile_cache() -> str:
+    import jax
+
+    return jax.config.jax_compilation_cache_dir or ""
+
+
 def child_command(out: str, method: str, resume: bool, compile_cache: str) -> list[str]:
     return [sys.executable, "-m", __name__, out, method, "--compile-cache", compile_cache] + (
         ["--resume"] if resume else []
@@ -50,21 +57,19 @@ def child_command(out: str, method: str, resume: bool, compile_cache: str) -> li
 
 
 def _latest_iteration(out: str, sub: str, ran: dict) -> int | None:
-    """The first member's newest recorded iteration, read from the end of its metrics file."""
-    path = os.path.join(out, sub, ran["members"][0]["run_dir"], "metrics.jsonl")
+    """The first member's newest recorded iteration (a metrics file being written may be torn or absent)."""
     try:
-        with open(path, "rb") as fh:
-            fh.seek(max(0, os.path.getsize(path) - 4096))
-            last = fh.read().decode(errors="replace").strip().splitlines()[-1]
-        return int(last.split('"iteration": ', 1)[1].split(",", 1)[0])
-    except (OSError, IndexError, ValueError):
+        records = read_metrics(os.path.join(out, sub, ran["members"][0]["run_dir"], METRICS))
+    except checkpoint.CheckpointError:
         return None
+    return records[-1]["iteration"] if records else None
 
 
-def train_side_by_side(out: str, record: dict, quiet: bool, resume: bool = False, compile_cache: str = "") -> None:
-    """Trains every sweep of ``record`` at once, one child process each, and notes each one's seconds in
-    OUT/figure.json as it ends. Raises ``loop.Interrupted`` after passing a signal on (the children have
-    checkpointed), ``loop.RunStopped`` naming the methods whose process failed and their logs."""
+def train_side_by_side(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
+    """Trains every sweep of ``record`` at once, one child process each (with this process's compile
+    cache), and notes each one's seconds in OUT/figure.json as it ends. Raises ``loop.Interrupted`` after
+    passing a signal on (the children have checkpointed), ``loop.RunStopped`` naming the methods whose
+    process failed and their logs."""
     loop.write_json(os.path.join(out, SPEC), record)  # what each child reads
     logs = os.path.join(out, LOGS)
     os.makedirs(logs, exist_ok=True)
@@ -72,7 +77,7 @@ def train_side_by_side(out: str, record: dict, quiet: bool, resume: bool = False
     jobs = []
     for method, ran, sub in sweeps(record):
         with open(os.path.join(logs, f"{method}.log"), "a") as log:  # the child holds its own copy of the file
-            cmd = child_command(out, method, resume, compile_cache)
+            cmd = child_command(out, method, resume, _compile_cache())
             proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env, start_new_session=True)
         jobs.append((method, ran, sub, proc, time.perf_counter()))
     progress.show(f"{record['figure']}: {len(jobs)} methods side by side, their output in {logs}", quiet)
