@@ -2,11 +2,11 @@
 program per geom pair, and on a GPU as one Pallas kernel per pair group.
 
 Why: after the constraint solve (``envs/fused_solver.py``), collision is the largest part of a Push control step on a
-GPU (about 530 small kernels of its 2,600 at 16 envs before the solve kernel; BENCHMARKS.md, "Time budget per stage"),
-and of MJX's collision for Push the box-box pair (the finger block against the cube) is 1,111 of its 1,612 traced
-equations. The arithmetic is MJX's: the separating-axis test over the 6 + 6 face normals and 9 edge crosses, the
-reference and incident faces, their clipping, the choice of four manifold points, the edge-contact rule; for a
-plane, the box's vertices within 1 mm of its deepest and the same choice of four.
+GPU (about 530 small kernels of its 2,600 at 16 envs before the solve kernel; experiments/NOTES.md, "What a control step
+launches"), and of MJX's collision for Push the box-box pair (the finger block against the cube) is 1,111 of its 1,612
+traced equations. The arithmetic is MJX's: the separating-axis test over the 6 + 6 face normals and 9 edge crosses, the
+reference and incident faces, their clipping, the choice of four manifold points, the edge-contact rule; for a plane,
+the box's vertices within 1 mm of its deepest and the same choice of four.
 
 Written for what a Triton kernel holds: vectors as (x, y, z) tuples of arrays, no gathers (picks by masks), argmax
 and argmin as the first index of the extreme, no concatenation, no constant arrays (vertices and faces from iota),
