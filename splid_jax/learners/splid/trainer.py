@@ -23,7 +23,6 @@ from splid_jax.learners.imitation.candidates import Candidates
 from splid_jax.learners.imitation.config import ImitationConfig, select_modes
 from splid_jax.learners.imitation.explore import Seen, Trajectory, draws, hold_fingers, rollout
 from splid_jax.learners.splid.select import held_pairs, select
-from splid_jax.runtime.devices import ENVS
 
 
 @struct.dataclass
@@ -61,7 +60,7 @@ class Trainer(Chunked):
     each (``grows_horizon``, ``clones_every_pair``). Holds what is
     static (task, network, optimiser, shapes); all state flows through arguments.
 
-    With a ``mesh`` (one axis, ``devices.ENVS``) each device explores and SELECTs its slice of the
+    With a ``mesh`` (one axis: the envs') each device explores and SELECTs its slice of the
     envs; the pairs come back in the one-device layout, and insertion, BC and the parameters are
     replicated, so the run computes what one device would, up to float rounding."""
 
@@ -169,8 +168,9 @@ class Trainer(Chunked):
         inside the mesh's ``shard_map``, this device's slice, gathered back in the one-device layout."""
         if self.mesh is None:
             return self._explore_and_select(pstate, reset_keys, noise, sigma, horizon, reach)
+        (axis,) = self.mesh.axis_names
         n = self.cfg.num_envs // self.mesh.size
-        first = jax.lax.axis_index(ENVS) * n
+        first = jax.lax.axis_index(axis) * n
         seen, cands = self._explore_and_select(
             pstate,
             jax.lax.dynamic_slice_in_dim(reset_keys, first, n, axis=0),
@@ -179,13 +179,13 @@ class Trainer(Chunked):
             horizon,
             reach,
         )
-        gather = lambda x: jax.lax.all_gather(x, ENVS, axis=1, tiled=True)  # noqa: E731  [T, n] -> [T, N]
+        gather = lambda x: jax.lax.all_gather(x, axis, axis=1, tiled=True)  # noqa: E731  [T, n] -> [T, N]
         seen = jax.tree.map(gather, seen)
         if cands is None:
             return seen, None
         # [H*T*n] in layout [H, T, n] -> [H*T, N] -> the one-device layout [H, T, N]
         whole = [gather(x.reshape((-1, n) + x.shape[1:])).reshape((-1,) + x.shape[1:]) for x in cands[:-1]]
-        return seen, Candidates(*whole, jax.lax.psum(cands.replay_steps, ENVS))
+        return seen, Candidates(*whole, jax.lax.psum(cands.replay_steps, axis))
 
     def _explore_and_select(self, pstate, reset_keys, noise, sigma, horizon, reach) -> tuple[Seen, Candidates | None]:
         traj = rollout(self.env, self.policy, pstate, reset_keys, noise, sigma, reach)
