@@ -30,7 +30,6 @@ from splid_jax.learners.imitation.explore import draws, rollout
 from splid_jax.learners.registry import make_algorithm
 from splid_jax.learners.splid.select import num_lanes, select
 from splid_jax.learners.splid.trainer import Trainer
-from splid_jax.runtime.loop import make_env
 
 
 def timed(fn, *args, repeats: int):
@@ -146,7 +145,7 @@ def main() -> None:
         run_dir="/tmp/x",
         env_options=a.env_options,
     )
-    env = make_env(a.env, **base.env_overrides())
+    env = base.make_env()
     dev = jax.devices()[0]
     res = {
         "env": a.env,

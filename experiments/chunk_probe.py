@@ -71,7 +71,7 @@ def watched(name: str, limit: float, log: list[dict], fn, *args):
 
 def probe(run_dir: str, limit: float, members: list[int] | None, log: list[dict]) -> int:
     base, lanes = configs(run_dir)
-    env = loop.make_env(base.env, **base.env_overrides())
+    env = base.make_env()
     algo = make_algorithm(base, env)
     if not hasattr(algo, "select"):
         raise SystemExit(f"{run_dir}: a {base.algo} run; the probe replays the cloning learners' stages")

@@ -45,9 +45,10 @@ import jax  # noqa: E402
 jax.devices()
 mark(f"backend ready ({jax.default_backend()})")
 
+from splid_jax.config import TrainConfig  # noqa: E402
 from splid_jax.runtime import checkpoint, loop  # noqa: E402
 
-timed(train, "make_env")
+timed(TrainConfig, "make_env")
 timed(loop, "initial_state", block=True)
 timed(checkpoint, "save")
 timed(loop._Loop, "check_state_fits")

@@ -23,7 +23,6 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-import envs
 from envs.base import step_batch
 from splid_jax.common.subgoals import steered
 from splid_jax.common.values import parse_overrides, typed_fields
@@ -125,7 +124,7 @@ def run_arm(
     train = typed_fields(TrainConfig, {k: v for k, v in merged.items() if not k.startswith("her_")}, "set")
     cfg = TrainConfig(env=env_name, **train)
     with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
-        env = envs.make(cfg.env, **cfg.env_overrides())
+        env = cfg.make_env()
     trainer = HER(env, cfg, HerConfig(**her)) if cfg.algo == "her" else Trainer(env, cfg)
     keys = jnp.stack([jax.random.PRNGKey(first_seed + s) for s in range(seeds)])
     state = jax.jit(jax.vmap(trainer.init))(keys)

@@ -31,7 +31,6 @@ from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.explore import draws, rollout
 from splid_jax.learners.registry import make_algorithm
 from splid_jax.runtime import programs
-from splid_jax.runtime.loop import make_env
 from splid_jax.runtime.signals import Signals
 
 
@@ -60,7 +59,7 @@ def shown(cfg: TrainConfig, *keys: str) -> dict:
 def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int, warm_chunks: int,
                  chunk_only: bool = False, settings: dict | None = None) -> dict:  # fmt: skip
     cfg = TrainConfig(env=env_name, env_options=env_options, run_dir="/tmp/stage-budget", **(settings or {}))
-    env = make_env(cfg.env, **cfg.env_overrides())
+    env = cfg.make_env()
     algo = make_algorithm(cfg, env)
     hyper = algo.hyper()
     state = algo.init(jax.random.PRNGKey(0))
@@ -107,7 +106,7 @@ def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: i
 def her_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int, warm_chunks: int,
                chunk_only: bool = False) -> dict:  # fmt: skip
     cfg = TrainConfig(env=env_name, env_options=env_options, algo="her", run_dir="/tmp/stage-budget-her")
-    env = make_env(cfg.env, **cfg.env_overrides())
+    env = cfg.make_env()
     algo = make_algorithm(cfg, env)
     state = algo.init(jax.random.PRNGKey(0))
     rows = {}

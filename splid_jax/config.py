@@ -296,6 +296,10 @@ class TrainConfig:
     def env_overrides(self) -> dict[str, Any]:
         return parse_overrides(self.env_options)
 
+    def make_env(self) -> envs.GoalEnv:
+        """The task this run trains on: ``env`` with the fields ``env_options`` changes."""
+        return envs.make(self.env, **self.env_overrides())
+
     def learner_config(self):
         """The learner's own settings (``ImitationConfig``, ``HerConfig``, ``EsConfig``), validated."""
         return registry.settings(self)

@@ -22,7 +22,6 @@ from splid_jax.common.subgoals import steered
 from splid_jax.config import TrainConfig
 from splid_jax.learners.registry import make_algorithm
 from splid_jax.runtime import checkpoint
-from splid_jax.runtime.loop import make_env
 from splid_jax.runtime.memory import device_memory, gigabytes, nbytes
 from splid_jax.runtime.run_files import note_task_changes
 
@@ -55,7 +54,7 @@ def load_policy(cfg: TrainConfig, step: int | None = None):
     """The task, the run's algorithm and its trained state at checkpoint ``step`` (default: the newest).
     Every algorithm acts through ``algo.policy`` with the ``networks.PolicyState`` at ``state.policy``:
     SPLID's, GCSL's and PCHID's cloned policy, HER's actor, ES's search mean."""
-    env = make_env(cfg.env, **cfg.env_overrides())
+    env = cfg.make_env()
     trainer = make_algorithm(cfg, env)
     like = jax.eval_shape(trainer.init, jax.random.PRNGKey(0))
     step, state, meta = checkpoint.restore(cfg.run_dir, like, step=step)

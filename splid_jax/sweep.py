@@ -45,7 +45,7 @@ from splid_jax.runtime import (  # noqa: E402
     progress,
     run_files,  # noqa: E402
 )
-from splid_jax.runtime.loop import RunStopped, make_env  # noqa: E402
+from splid_jax.runtime.loop import RunStopped  # noqa: E402
 from splid_jax.tensorboard import recording  # noqa: E402
 
 
@@ -127,7 +127,7 @@ def grid_configs(
 def run_sweep(cfg: TrainConfig, grid: list[Member], quiet: bool = False, resume: bool = False) -> list[dict]:
     """Train every member of ``grid`` in lock-step; returns each member's last metrics record."""
     base, lanes = member_configs(cfg, grid)
-    env = make_env(base.env, **base.env_overrides())
+    env = base.make_env()
     base.check_env(env)
     return loop.run(base, env, members=lanes, resume=resume, quiet=quiet)
 
@@ -284,7 +284,7 @@ def main(argv: list[str] | None = None) -> int:
             for field in varied.keys() & given.keys():
                 raise InvalidConfig(field, given[field], f"given once: either --{field.replace('_', '-')} or --vary")
             cfg, lanes = grid_configs(given, seeds, sigmas, horizons, varied)
-        env = make_env(cfg.env, **cfg.env_overrides())
+        env = cfg.make_env()
         cfg.check_env(env)
         with recording(ns.tensorboard, per_member=True) as on_record:
             loop.run(cfg, env, members=lanes, resume=bool(ns.resume), quiet=ns.quiet, on_record=on_record)

@@ -33,10 +33,10 @@ from splid_jax.common.paths import unreadable  # noqa: E402
 from splid_jax.config import PROVENANCE, TASK_DEFAULTS, TrainConfig  # noqa: E402
 from splid_jax.learners import registry  # noqa: E402
 from splid_jax.runtime import checkpoint, loop, multihost, progress  # noqa: E402
-from splid_jax.runtime.loop import RunStopped, make_env  # noqa: E402
+from splid_jax.runtime.loop import RunStopped  # noqa: E402
 from splid_jax.runtime.run_files import EXPORT, MAY_CHANGE_ON_RESUME, env_settings  # noqa: E402
 
-__all__ = ["RunStopped", "build_parser", "config_from_cli", "env_settings", "main", "make_env", "run"]
+__all__ = ["RunStopped", "build_parser", "config_from_cli", "env_settings", "main", "run"]
 
 
 def run(
@@ -118,7 +118,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         start_processes(ns)
         cfg, resume = multihost.from_first(lambda: config_from_cli(ns))  # its --resume directory: process 0's
-        env = make_env(cfg.env, **cfg.env_overrides())
+        env = cfg.make_env()
         cfg.check_env(env)
         rec = run(cfg, env, resume=resume, quiet=ns.quiet, tensorboard=ns.tensorboard)
     except InvalidConfig as err:

@@ -15,7 +15,6 @@ from splid_jax.config import TASK_DEFAULTS, TrainConfig
 from splid_jax.figures.registry import METHODS, Spec, member_name
 from splid_jax.figures.settings import reads
 from splid_jax.learners import registry as learners
-from splid_jax.runtime import loop
 
 # Exploration episodes per method by default (the paper's x axes); other tasks: their default run's.
 BUDGETS = {"push": 20_000, "slide": 100_000, "pick_and_place": 100_000}
@@ -78,7 +77,7 @@ def plan(
         probe = TrainConfig(**fields, run_dir=os.path.join(out, name))
         options = probe.env_options
         if options not in made:
-            made[options] = loop.make_env(env_name, **probe.env_overrides())
+            made[options] = probe.make_env()
         env = made[options]
         probe.check_env(env)
         per_iteration = learners.make_algorithm(probe, env).counters(1, 0)["episodes"]

@@ -35,5 +35,5 @@ def train_sweep(out: str, record: dict, method: str, ran: dict, sub: str, quiet:
         f"(budget {record['budget_episodes']:,})" + (", resumed" if again else ""),
         quiet,
     )
-    env = loop.make_env(base.env, **base.env_overrides())
+    env = base.make_env()
     loop.run(base, env, members=lanes, resume=again, quiet=quiet)

@@ -77,10 +77,10 @@ def scripted(task: str, episodes: int, seed: int) -> tuple[dict, dict]:
     import jax
 
     with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
+        import envs
         from envs.fetch.scripted import CONTROLLERS
-        from splid_jax.runtime.loop import make_env
     import_reference()
-    env = make_env(task)
+    env = envs.make(task)
     act = CONTROLLERS[task]
     tr = traces(env, task, act, jax.jit(act), episodes, seed)
     result = {"scripted": task, "task": task, "reference": REFERENCE_IDS[task], "seed": seed}
@@ -128,9 +128,9 @@ def main(argv: list[str] | None = None) -> int:
     print(_line("ours (MJX)", result["ours"]))
     print(_line(result["reference"], result["fetch"]))
     if a.traces:
-        from splid_jax.runtime.loop import make_env
+        import envs
 
-        resp = step_response(make_env(result["task"]), result["task"])
+        resp = step_response(envs.make(result["task"]), result["task"])
         os.makedirs(_folder(a.traces), exist_ok=True)
         np.savez_compressed(a.traces, **tr, **{f"response_{k}": np.asarray(resp[k]) for k in RESPONSE_KEYS})
         result["traces"] = {"file": a.traces, "ours": split_by_final(tr, "ours"), "fetch": split_by_final(tr, "fetch")}

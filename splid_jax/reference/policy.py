@@ -37,12 +37,11 @@ def restore_sweep(directory: str, env=None, step: int | None = None):
     from splid_jax.config import TrainConfig
     from splid_jax.learners.registry import make_algorithm
     from splid_jax.runtime import checkpoint
-    from splid_jax.runtime.loop import make_env
 
     with open(os.path.join(directory, "sweep.json")) as fh:
         saved = json.load(fh)
     cfg = TrainConfig.from_json(saved["config"], run_dir=directory)
-    env = make_env(cfg.env, **cfg.env_overrides()) if env is None else env
+    env = cfg.make_env() if env is None else env
     trainer = make_algorithm(cfg, env)
     members = len(saved.get("members", []))
     like = jax.eval_shape(jax.vmap(trainer.init), jax.random.split(jax.random.PRNGKey(0), members))
@@ -55,11 +54,10 @@ def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
     (members differ only in data, not in shapes)."""
     import jax
 
-    from splid_jax.runtime.loop import make_env
     from splid_jax.runtime.run_files import note_task_changes
 
     directory, index, _ = sweep
-    env = make_env(cfg.env, **cfg.env_overrides())  # the member's task, with any changed fields
+    env = cfg.make_env()  # the member's task, with any changed fields
     env, trainer, state, step, meta = restore_sweep(directory, env, step)
     note_task_changes(cfg.run_dir, meta.get("env", {}), env)
     return env, trainer, jax.tree.map(lambda x: x[index], state), step

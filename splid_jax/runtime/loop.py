@@ -61,9 +61,6 @@ class RunStopped(RuntimeError):
     """The run stopped early for a reason the user must see (NaN); exit code 3."""
 
 
-make_env = envs.make  # the task a run's config names, as the commands and scripts import it
-
-
 def placement(cfg: TrainConfig, members: int | None, algo: Algorithm | None = None) -> devices.Placement:
     """The devices a run (``members`` None) or a sweep of ``members`` uses (``cfg.num_devices``)."""
     if members is not None:
@@ -149,7 +146,7 @@ def run(
     trained in lock-step as one vmapped program with checkpoints under ``cfg.run_dir``. Over several
     processes every process calls it alike and each returns the records; only process 0 writes and shows."""
     with Signals() as signals, lock.hold(cfg.run_dir, multihost.is_first()):
-        env = env or signals.wait(lambda: make_env(cfg.env, **cfg.env_overrides()))
+        env = env or signals.wait(cfg.make_env)
         place = placement(cfg, None if members is None else len(members), algo)
         split_envs = place.axis == devices.ENVS and place.count > 1
         algo = algo or signals.wait(lambda: registry.make_algorithm(cfg, env, place.mesh if split_envs else None))

@@ -3,6 +3,7 @@ import json
 
 import pytest
 
+import envs
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 
@@ -159,6 +160,12 @@ def test_pick_and_place_trains_from_grasped_starts_unless_told_otherwise():
     spaced = {**before, "env_options": "grasped_starts=0, finger_drive=fast"}  # as a user wrote it then
     assert TrainConfig.from_json(spaced).env_options == spaced["env_options"]  # as its checkpoint recorded it
     assert TrainConfig(env="push").env_options == ""
+
+
+def test_a_configs_task_carries_its_options():
+    env = TrainConfig(env="point", env_options="max_episode_steps=20,door_half_width=0.5").make_env()
+    assert (env.max_episode_steps, env.door_half_width) == (20, 0.5)
+    assert TrainConfig(env="point").make_env() == envs.make("point")
 
 
 def test_the_fetch_tasks_but_reach_evaluate_with_subgoals_and_runs_recorded_before_them_read_back_without():

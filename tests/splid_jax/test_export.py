@@ -6,12 +6,12 @@ import json
 import jax
 import numpy as np
 
+from envs import make as make_env
 from splid_jax import export, train
 from splid_jax.config import TrainConfig
 from splid_jax.learners.registry import make_algorithm
 from splid_jax.reference.policy import restore_run
 from splid_jax.runtime import checkpoint
-from splid_jax.runtime.loop import make_env
 from splid_jax.runtime.run_files import env_settings
 
 

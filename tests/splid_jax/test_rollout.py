@@ -6,11 +6,12 @@ import mujoco
 import numpy as np
 import pytest
 
+from envs import make as make_env
 from splid_jax import rollout
 from splid_jax.config import TrainConfig
 from splid_jax.learners.splid.trainer import Trainer
 from splid_jax.runtime import checkpoint
-from splid_jax.train import env_settings, make_env
+from splid_jax.train import env_settings
 from splid_jax.train import main as train_main
 
 
@@ -30,7 +31,7 @@ def reach_run(tmp_path_factory):
     run_dir = tmp_path_factory.mktemp("reach") / "run"
     cfg = TrainConfig(env="reach", env_options="max_episode_steps=5", iterations=1, eval_every=1, num_envs=2, horizon=2,
                       hidden=(8,), buffer_size=16, batch_size=4, run_dir=str(run_dir))  # fmt: skip
-    env = make_env(cfg.env, **cfg.env_overrides())
+    env = cfg.make_env()
     checkpoint.save(run_dir, 0, Trainer(env, cfg).init(jax.random.PRNGKey(0)), {"env": env_settings(env)})
     (run_dir / "config.json").write_text(json.dumps(cfg.to_json()))
     return run_dir

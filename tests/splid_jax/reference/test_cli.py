@@ -10,12 +10,12 @@ import pytest
 
 pytest.importorskip("gymnasium_robotics")
 
+from envs import make as make_env  # noqa: E402
 from envs.fetch import scripted  # noqa: E402
 from splid_jax.config import TrainConfig  # noqa: E402
 from splid_jax.learners.registry import make_algorithm  # noqa: E402
 from splid_jax.reference import cli, episodes  # noqa: E402
 from splid_jax.runtime import checkpoint  # noqa: E402
-from splid_jax.runtime.loop import make_env  # noqa: E402
 from splid_jax.runtime.run_files import env_settings  # noqa: E402
 
 
@@ -23,7 +23,7 @@ def _init_run(run_dir, env_name: str, **fields):
     """A run directory holding the untrained state of a small run: config.json and checkpoint 0."""
     cfg = TrainConfig(env=env_name, iterations=1, eval_every=1, num_envs=2, horizon=2, hidden=(8,), buffer_size=16,
                       batch_size=4, run_dir=str(run_dir), **fields)  # fmt: skip
-    env = make_env(cfg.env, **cfg.env_overrides())
+    env = cfg.make_env()
     checkpoint.save(run_dir, 0, make_algorithm(cfg, env).init(jax.random.PRNGKey(0)), {"env": env_settings(env)})
     (run_dir / "config.json").write_text(json.dumps(cfg.to_json()))
     return run_dir

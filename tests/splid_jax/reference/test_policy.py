@@ -8,11 +8,11 @@ import pytest
 
 pytest.importorskip("gymnasium_robotics")
 
+from envs import make as make_env  # noqa: E402
 from splid_jax.config import TrainConfig  # noqa: E402
 from splid_jax.learners.registry import make_algorithm  # noqa: E402
 from splid_jax.reference import policy  # noqa: E402
 from splid_jax.runtime import checkpoint  # noqa: E402
-from splid_jax.runtime.loop import make_env  # noqa: E402
 from splid_jax.runtime.run_files import env_settings  # noqa: E402
 
 

@@ -5,8 +5,8 @@ import pytest
 
 pytest.importorskip("gymnasium_robotics")
 
+from envs import make as make_env  # noqa: E402
 from splid_jax.reference import response  # noqa: E402
-from splid_jax.runtime.loop import make_env  # noqa: E402
 
 
 @pytest.mark.slow
