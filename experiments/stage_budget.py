@@ -30,7 +30,7 @@ from splid_jax.figures.settings import parse_sets
 from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.explore import draws, rollout
 from splid_jax.learners.registry import make_algorithm
-from splid_jax.runtime import programs
+from splid_jax.runtime import loop, programs
 from splid_jax.runtime.signals import Signals
 
 
@@ -38,8 +38,9 @@ def chunk_row(algo, state, hyper, cfg: TrainConfig, chunk_repeats: int, warm_chu
     """The whole chunk's timing row, after ``warm_chunks`` (>= 1) trained chunks (the first one's time,
     compilation included, less the median is the compile time), and the state they left. The chunk is
     compiled and run as the host loop does (``runtime.programs``: training and report side by side)."""
-    state, hyper = jax.tree.map(lambda x: jnp.array(x, dtype=jnp.result_type(x)), (state, hyper))  # as placed
-    like = jax.tree.map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=x.sharding), (state, hyper))
+    sharding = jax.sharding.SingleDeviceSharding(jax.devices()[0])
+    state, hyper = loop.canonical((state, hyper), sharding)
+    like = loop.abstract((state, hyper), sharding)
     t0 = time.perf_counter()
     chunk = programs.compile_all(programs.trace(programs.parts(algo, stacked=False), *like), Signals())
     state, _ = jax.block_until_ready(chunk(state, hyper))

@@ -100,7 +100,7 @@ def initial_state(init: Callable[[jax.Array], Any], keys: jax.Array, stacked: bo
     return jax.tree.map(lambda *x: jnp.stack(x), *[one(k) for k in keys])
 
 
-def _canonical(tree, sharding):
+def canonical(tree, sharding):
     """Strongly typed arrays placed as ``sharding`` says, whether they come from init or a checkpoint,
     so the compiled chunk takes a resumed state as it takes a fresh one."""
     # made on one device, then placed: XLA:CPU can hang in a later program that reads an array a
@@ -112,7 +112,8 @@ def _strong(tree):
     return jax.tree.map(lambda x: jnp.asarray(x).astype(jnp.asarray(x).dtype), tree)
 
 
-def _abstract(tree, sharding):
+def abstract(tree, sharding):
+    """``tree``'s shapes and dtypes placed as ``sharding`` says: what ``canonical`` makes of it, abstractly."""
     return jax.tree.map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=sharding), tree)
 
 
@@ -246,16 +247,16 @@ class _Loop:
         fns = programs.parts(algo, self.stacked)
         groups = Groups(place, len(self.lanes)) if split else None
         sharding = place.state_sharding() if groups is None else jax.sharding.SingleDeviceSharding(self.device)
-        like = _abstract(jax.eval_shape(init, keys_like), sharding)  # the whole sweep's, as checkpoints hold it
+        like = abstract(jax.eval_shape(init, keys_like), sharding)  # the whole sweep's, as checkpoints hold it
         one = like if groups is None else groups.first(like)  # what one compiled program takes
-        hyper_one = _abstract(hyper_like, sharding)  # strongly typed, as _canonical makes the values
+        hyper_one = abstract(hyper_like, sharding)  # strongly typed, as canonical makes the values
 
         def made():  # the device's first programs, built while the chunk is compiled
             keys, hyper = stack()
             if resume:
-                return _canonical(hyper, sharding), None
+                return canonical(hyper, sharding), None
             state = initial_state(algo.init, keys, self.stacked, self.device.platform == "cpu")
-            return _canonical(hyper, sharding), _canonical(state, sharding)
+            return canonical(hyper, sharding), canonical(state, sharding)
 
         t0 = time.perf_counter()
         try:
@@ -345,7 +346,7 @@ class _Loop:
         if self.stacked and self.place.axis == devices.MEMBERS and self.place.count > 1:
             state = Groups(self.place, len(self.lanes)).split(state)
         else:
-            state = _canonical(state, self.place.state_sharding())
+            state = canonical(state, self.place.state_sharding())
         return state, [int(s) for s in meta["select_steps"]], float(meta["wall_s"])
 
     def wait_for_write(self) -> None:
