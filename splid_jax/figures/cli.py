@@ -21,7 +21,7 @@ from splid_jax.figures.record import check_out, load_record
 from splid_jax.figures.registry import METHODS, SPECS
 from splid_jax.figures.runs import train
 from splid_jax.figures.settings import parse_methods, parse_sets, parse_values
-from splid_jax.figures.side_by_side import train_side_by_side
+from splid_jax.figures.side_by_side import share_gpu_memory, train_side_by_side
 from splid_jax.runtime import checkpoint, lock, loop, progress
 
 HELP = """\
@@ -135,8 +135,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         else os.path.join("experiments", "results", today, f"{ns.figure}-{env_name}")
     )
     use_compile_cache(ns.compile_cache)
-    if ns.side_by_side:  # the children share the GPU: this process must not take most of its memory first
-        os.environ.setdefault("XLA_PYTHON_CLIENT_PREALLOCATE", "false")
+    if ns.side_by_side:  # before this process first touches the GPU
+        share_gpu_memory()
     try:
         with lock.hold(out, field="out"):  # one process per figure directory
             check(bool(ns.merge) or not ns.replace, "replace", True, "given with --merge")

@@ -21,6 +21,7 @@ import subprocess
 import sys
 import threading
 import time
+from typing import NamedTuple
 
 from splid_jax.figures.record import SPEC, load_record, sweeps
 from splid_jax.figures.runs import train_sweep
@@ -31,6 +32,20 @@ LOGS = "logs"
 POLL_S = 0.5
 REPORT_S = 30.0  # seconds between progress lines
 MPS_PIPE = "/tmp/nvidia-mps"  # where CUDA MPS's control daemon listens unless CUDA_MPS_PIPE_DIRECTORY says otherwise
+
+
+class Job(NamedTuple):
+    method: str
+    ran: dict  # the method's sweep in the figure's record
+    sub: str  # its directory under OUT
+    proc: subprocess.Popen
+    start: float  # perf_counter at its launch
+
+
+def share_gpu_memory() -> None:
+    """Keeps this process and its children from taking most of the GPU's memory at their first use (JAX's
+    default), so the children fit on one GPU beside each other; a value already set stays."""
+    os.environ.setdefault("XLA_PYTHON_CLIENT_PREALLOCATE", "false")
 
 
 def mps_running() -> bool:
@@ -73,13 +88,13 @@ def train_side_by_side(out: str, record: dict, quiet: bool, resume: bool = False
     loop.write_json(os.path.join(out, SPEC), record)  # what each child reads
     logs = os.path.join(out, LOGS)
     os.makedirs(logs, exist_ok=True)
-    env = {**os.environ, "XLA_PYTHON_CLIENT_PREALLOCATE": os.environ.get("XLA_PYTHON_CLIENT_PREALLOCATE", "false")}
+    share_gpu_memory()  # the children inherit it
     jobs = []
     for method, ran, sub in sweeps(record):
         with open(os.path.join(logs, f"{method}.log"), "a") as log:  # the child holds its own copy of the file
             cmd = child_command(out, method, resume, _compile_cache())
-            proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env, start_new_session=True)
-        jobs.append((method, ran, sub, proc, time.perf_counter()))
+            proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+        jobs.append(Job(method, ran, sub, proc, time.perf_counter()))
     progress.show(f"{record['figure']}: {len(jobs)} methods side by side, their output in {logs}", quiet)
     if not mps_running() and _on_gpu():
         print(
@@ -91,38 +106,38 @@ def train_side_by_side(out: str, record: dict, quiet: bool, resume: bool = False
 
     def pass_on(signum, frame):
         caught.append(signum)
-        for _, _, _, proc, _ in jobs:
-            if proc.poll() is None:
-                proc.send_signal(signum)
+        for job in jobs:
+            if job.proc.poll() is None:
+                job.proc.send_signal(signum)
 
     previous = {sig: signal.signal(sig, pass_on) for sig in (signal.SIGINT, signal.SIGTERM)}
     running, t0, reported = list(jobs), time.perf_counter(), time.perf_counter()
     try:
         while running:
             time.sleep(POLL_S)
-            for job in [j for j in running if j[3].poll() is not None]:
+            for job in [j for j in running if j.proc.poll() is not None]:
                 running.remove(job)
-                _, ran, _, _, start = job
-                ran["total_s"] = round(ran.get("total_s", 0.0) + time.perf_counter() - start, 1)
+                job.ran["total_s"] = round(job.ran.get("total_s", 0.0) + time.perf_counter() - job.start, 1)
                 loop.write_json(os.path.join(out, SPEC), record)
             if running and time.perf_counter() - reported >= REPORT_S:
                 reported = time.perf_counter()
                 states = [
-                    f"{m} {'ended' if p.poll() is not None else _latest_iteration(out, s, r) or 0}"
-                    + ("" if p.poll() is not None else f"/{r['config']['iterations']}")
-                    for m, r, s, p, _ in jobs
+                    f"{j.method} ended"
+                    if j not in running
+                    else f"{j.method} {_latest_iteration(out, j.sub, j.ran) or 0}/{j.ran['config']['iterations']}"
+                    for j in jobs
                 ]
                 elapsed = time.perf_counter() - t0
                 progress.show(f"{record['figure']} side by side, {elapsed:.0f} s: " + ", ".join(states), quiet)
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-        for _, _, _, proc, _ in running:  # an error here: the children stop with it, checkpointed
-            proc.send_signal(signal.SIGTERM)
-            proc.wait()
+        for job in running:  # an error here: the children stop with it, checkpointed
+            job.proc.send_signal(signal.SIGTERM)
+            job.proc.wait()
     if caught:
         raise loop.Interrupted(caught[0])
-    failed = [(m, p.returncode) for m, _, _, p, _ in jobs if p.returncode != 0]
+    failed = [(j.method, j.proc.returncode) for j in jobs if j.proc.returncode != 0]
     if failed:
         named = ", ".join(f"{m} (exit {rc}, {os.path.join(logs, m + '.log')})" for m, rc in failed)
         raise loop.RunStopped(f"{len(failed)} of {len(jobs)} methods failed: {named}; the others finished")
