@@ -13,8 +13,6 @@ them; ``--replot ARM.json...`` redraws that figure from saved arms."""
 from __future__ import annotations
 
 import argparse
-import contextlib
-import io
 import json
 import os
 import time
@@ -123,8 +121,7 @@ def run_arm(
     her = typed_fields(HerConfig, {k[4:]: v for k, v in merged.items() if k.startswith("her_")}, "set.her")
     train = typed_fields(TrainConfig, {k: v for k, v in merged.items() if not k.startswith("her_")}, "set")
     cfg = TrainConfig(env=env_name, **train)
-    with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
-        env = cfg.make_env()
+    env = cfg.make_env()
     trainer = HER(env, cfg, HerConfig(**her)) if cfg.algo == "her" else Trainer(env, cfg)
     keys = jnp.stack([jax.random.PRNGKey(first_seed + s) for s in range(seeds)])
     state = jax.jit(jax.vmap(trainer.init))(keys)

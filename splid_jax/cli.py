@@ -6,9 +6,7 @@ signal while JAX loads can already be handled."""
 from __future__ import annotations
 
 import argparse
-import contextlib
 import dataclasses
-import io
 import os
 import signal
 import sys
@@ -72,8 +70,7 @@ def task_fields() -> str:
 
     parts, previous = [], None
     for name in envs.names():
-        with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
-            cls = envs.task_class(name)
+        cls = envs.task_class(name)
         defaults = {f.name: _marked(f) for f in dataclasses.fields(cls)}
         if previous is not None and previous[1].keys() == defaults.keys():
             diff = {k: v for k, v in defaults.items() if v != previous[1][k]}
