@@ -105,8 +105,9 @@ def splid_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: i
 
 
 def her_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int, warm_chunks: int,
-               chunk_only: bool = False) -> dict:  # fmt: skip
-    cfg = TrainConfig(env=env_name, env_options=env_options, algo="her", run_dir="/tmp/stage-budget-her")
+               chunk_only: bool = False, her_options: str = "", num_envs: int | None = None) -> dict:  # fmt: skip
+    cfg = TrainConfig(env=env_name, env_options=env_options, algo="her", run_dir="/tmp/stage-budget-her",
+                      her_options=her_options, num_envs=num_envs)  # fmt: skip
     env = cfg.make_env()
     algo = make_algorithm(cfg, env)
     state = algo.init(jax.random.PRNGKey(0))
@@ -128,7 +129,7 @@ def her_budget(env_name: str, env_options: str, repeats: int, chunk_repeats: int
     rows["store_and_normalise"], state = timed(jax.jit(store_fn), state, episodes, valid, key, repeats=repeats)
 
     rows["updates"], _ = timed(jax.jit(algo.updates), state, key, repeats=repeats)
-    rows["updates"]["steps"] = algo.her.n_batches
+    rows["updates"]["steps"] = algo.n_updates
 
     def eval_fn(pstate, key):
         return evaluate(env, algo.policy, pstate, key, cfg.eval_episodes)
@@ -151,6 +152,8 @@ def main() -> None:
     p.add_argument(
         "--set", action="append", default=[], help="a SPLID setting as FIELD=VALUE, e.g. select_lanes=2; repeatable"
     )
+    p.add_argument("--her-options", default="", help="HER's settings as KEY=VALUE[,KEY=VALUE...]")
+    p.add_argument("--her-num-envs", type=int, default=None, help="HER's episodes per cycle (default: the task's)")
     p.add_argument("--out", required=True)
     args = p.parse_args()
     try:  # a wrong setting fails here, naming it, before any compile
@@ -169,7 +172,9 @@ def main() -> None:
     budgets = {"splid": splid_budget, "her": her_budget}
     for name in args.algos:
         sizes = (args.repeats, args.chunk_repeats, max(1, args.warm_chunks))
-        extra = {"settings": settings} if name == "splid" else {}
+        extra = {"settings": settings} if name == "splid" else {"her_options": args.her_options}
+        if name == "her":
+            extra["num_envs"] = args.her_num_envs
         result[name] = budgets[name](args.env, args.env_options, *sizes, chunk_only=args.chunk_only, **extra)
         with open(args.out, "w") as fh:  # after each learner, so a cut call keeps what it measured
             json.dump(result, fh, indent=2)

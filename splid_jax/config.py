@@ -16,12 +16,14 @@ from typing import Any
 import envs
 from splid_jax.common.errors import check
 from splid_jax.common.fields import field
-from splid_jax.common.values import format_overrides, parse_overrides
+from splid_jax.common.values import format_overrides, options_text, parse_options, parse_overrides
 from splid_jax.learners import registry
 
 MAX_ITERATIONS = 10**7  # far beyond any run's budget: a larger value is a typo, and would run for ever
-# Keys a run's config.json holds beside the fields: where it ran, not how to run it.
-PROVENANCE = ("devices",)
+# Keys a run's config.json holds beside the fields: where it ran, and which defaults its learner's options
+# are read against (HER's defaults were Baselines' before they became mrl's).
+PROVENANCE = ("devices", "her_defaults")
+HER_DEFAULTS = "mrl"
 
 
 _KINDS = {
@@ -316,7 +318,10 @@ class TrainConfig:
         check(ok, "gripper_hold", self.gripper_hold, allowed)
 
     def to_json(self) -> dict[str, Any]:
-        return dataclasses.asdict(self)
+        saved = dataclasses.asdict(self)
+        if self.algo == "her":
+            saved["her_defaults"] = HER_DEFAULTS
+        return saved
 
     @classmethod
     def unrecorded_values(cls) -> dict[str, Any]:
@@ -330,11 +335,25 @@ class TrainConfig:
         task gained a default option resumes as it ran; a setting added since reads as those runs behaved
         (its ``unrecorded`` value)."""
         unrecorded = cls.unrecorded_values()
+        if saved.get("algo") == "her" and saved.get("her_defaults") != HER_DEFAULTS and "her_options" not in changes:
+            saved = {**saved, "her_options": _on_baselines(saved.get("her_options", ""))}
         cfg = cls(**{**unrecorded, **{k: v for k, v in saved.items() if k not in PROVENANCE}, **changes})
         options = changes.get("env_options", saved.get("env_options"))
         if isinstance(options, str):  # checked by the construction above
             object.__setattr__(cfg, "env_options", options)
         return cfg
+
+
+def _on_baselines(text: Any) -> Any:
+    """A run's HER options, recorded against the Baselines defaults, as text against today's defaults."""
+    from splid_jax.learners.her.config import BASELINES, HerConfig
+
+    if not isinstance(text, str):
+        return text  # refused by the construction, naming the field
+    recorded = parse_options(HerConfig, text, "her_options", "her")
+    given = {part.partition("=")[0].strip() for part in text.split(",") if "=" in part}
+    changed = {name: getattr(recorded, name) for name in given}
+    return options_text(HerConfig(), **{**BASELINES, **changed})
 
 
 _POINT = dict(

@@ -18,17 +18,8 @@ from collections.abc import Sequence
 
 from splid_jax.cli import Parser, exit_with, quiet_interrupts
 from splid_jax.common.errors import InvalidConfig, check
+from splid_jax.common.values import options_text
 from splid_jax.runtime.run_files import EXPORT, METRICS, env_settings, write_json
-
-
-def _options(settings, **changed) -> str:
-    """A learner's options (``HerConfig``) as ``KEY=VALUE,...`` text: the fields that differ from their
-    defaults, with ``changed`` applied."""
-    values = {f.name: getattr(settings, f.name) for f in dataclasses.fields(settings)}
-    values.update(changed)
-    defaults = {f.name: f.default for f in dataclasses.fields(settings)}
-    show = lambda v: ",".join(map(str, v)) if isinstance(v, tuple) else str(v)  # noqa: E731
-    return ",".join(f"{k}={show(v)}" for k, v in values.items() if v != defaults[k])
 
 
 def without_buffer(cfg, env):
@@ -40,7 +31,7 @@ def without_buffer(cfg, env):
     if isinstance(settings, ImitationConfig):
         return dataclasses.replace(cfg, buffer_size=1, buffer_window=0, buffer_window_grow=0)
     if isinstance(settings, HerConfig):
-        return dataclasses.replace(cfg, her_options=_options(settings, buffer_transitions=env.episode_length))
+        return dataclasses.replace(cfg, her_options=options_text(settings, buffer_transitions=env.episode_length))
     return cfg  # ES keeps no buffer
 
 

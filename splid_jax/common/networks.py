@@ -22,18 +22,20 @@ STD_MIN = 0.01
 
 class MLP(nn.Module):
     """MLP with orthogonal init. Defaults: leaky-ReLU and a linear output (as SPLID's reference
-    code); HER's actor and critic use ReLU, and its actor a tanh output (as OpenAI Baselines)."""
+    code); HER's actor and critic use ReLU, and its actor a tanh output (as OpenAI Baselines and mrl)."""
 
     hidden: Sequence[int]
     action_size: int
     activation: str = "leaky_relu"  # a flax.linen activation: "leaky_relu" or "relu"
     tanh_output: bool = False
+    layer_norm: bool = False  # LayerNorm between each hidden layer and its activation (mrl's DDPG nets)
 
     @nn.compact
     def __call__(self, x: jax.Array) -> jax.Array:
         act = getattr(nn, self.activation)
         for width in self.hidden:
-            x = act(nn.Dense(width, kernel_init=nn.initializers.orthogonal(jnp.sqrt(2.0)))(x))
+            x = nn.Dense(width, kernel_init=nn.initializers.orthogonal(jnp.sqrt(2.0)))(x)
+            x = act(nn.LayerNorm()(x) if self.layer_norm else x)
         x = nn.Dense(self.action_size, kernel_init=nn.initializers.orthogonal(0.01))(x)
         return jnp.tanh(x) if self.tanh_output else x
 

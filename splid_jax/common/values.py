@@ -87,6 +87,16 @@ def parse_options(cls, text: str, field: str, prefix: str):
     return cls(**typed_fields(cls, overrides, prefix))
 
 
+def options_text(settings, **changed) -> str:
+    """A learner's config dataclass (``HerConfig``) as ``KEY=VALUE,...`` text that ``parse_options`` reads
+    back: the fields that differ from their defaults, with ``changed`` applied."""
+    values = {f.name: getattr(settings, f.name) for f in dataclasses.fields(settings)}
+    values.update(changed)
+    defaults = {f.name: f.default for f in dataclasses.fields(settings)}
+    show = lambda v: ",".join(map(str, v)) if isinstance(v, tuple) else str(v)  # noqa: E731
+    return ",".join(f"{k}={show(v)}" for k, v in values.items() if v != defaults[k])
+
+
 def typed_fields(cls, values: dict[str, Any], prefix: str) -> dict[str, Any]:
     """``values`` (as ``parse_overrides`` reads them) as the declared types of ``cls``'s fields; an
     unknown key or a value of another type fails naming ``prefix.KEY``."""

@@ -25,7 +25,7 @@ QUICK_FIELDS: dict[str, Any] = dict(
     num_envs=16, eval_every=5, eval_episodes=50, bc_steps=20, batch_size=64, hidden=(32, 32), buffer_size=20_000
 )
 QUICK_METHOD_FIELDS: dict[str, dict[str, Any]] = {
-    "her": dict(her_options="hidden=32,32,batch_size=64,n_batches=10,buffer_transitions=20000"),
+    "her": dict(her_options="hidden=32,32,batch_size=64,update_every=0,n_batches=10,buffer_transitions=20000"),
     "es": dict(es_options="population=16"),
 }
 

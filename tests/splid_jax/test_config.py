@@ -150,7 +150,7 @@ def test_push_horizon_falls_from_12_to_8_unless_the_caller_sets_h():
 
 def test_pick_and_place_trains_from_grasped_starts_unless_told_otherwise():
     assert TrainConfig(env="pick_and_place").env_overrides() == {"grasped_starts": 0.5}
-    assert TrainConfig(env="pick_and_place", algo="her").env_overrides() == {"grasped_starts": 0.5}
+    assert TrainConfig(env="pick_and_place", algo="her").env_overrides() == {"grasped_starts": 0}  # mrl's
     given = TrainConfig(env="pick_and_place", env_options="finger_drive=fast")  # the task's option stays
     assert given.env_overrides() == {"grasped_starts": 0.5, "finger_drive": "fast"}
     assert TrainConfig(env="pick_and_place", env_options="grasped_starts=0").env_overrides() == {"grasped_starts": 0}

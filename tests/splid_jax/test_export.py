@@ -46,7 +46,7 @@ def test_an_export_holds_the_runs_policy_and_a_one_slot_buffer(tmp_path, capsys)
 
 def test_her_exports_with_one_episode_of_replay_and_its_other_options_kept(tmp_path):
     run = tmp_path / "her"
-    state = _saved_run(run, algo="her", her_options="hidden=8,8,buffer_transitions=500,n_batches=2")
+    state = _saved_run(run, algo="her", her_options="hidden=8,8,buffer_transitions=500,update_every=0,n_batches=2")
     assert export.main([str(run), "--out", str(tmp_path / "out")]) == 0
     cfg, env, algo, loaded, _ = restore_run(str(tmp_path / "out" / "her"))
     her = cfg.learner_config()

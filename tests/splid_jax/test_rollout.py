@@ -203,7 +203,10 @@ def test_paths_figure_has_a_title_and_a_legend():
 
 @pytest.mark.parametrize(
     "algo,options",
-    [("her", {"her_options": "hidden=8,buffer_transitions=500"}), ("es", {"es_options": "population=4"})],
+    [
+        ("her", {"her_options": "hidden=8,buffer_transitions=500,update_every=0,n_batches=2"}),
+        ("es", {"es_options": "population=4"}),
+    ],
 )
 def test_rollout_acts_as_the_evaluation_of_a_her_or_es_run(tmp_path, capsys, algo, options):
     """HER's actor and ES's search mean both sit at ``state.policy``; rollout rolls what the loop evaluates."""

@@ -1,4 +1,6 @@
-"""HER's own settings, with the defaults of OpenAI Baselines."""
+"""HER's own settings. The defaults are the strongest public DDPG+HER, spitis/mrl's
+``best_slide_config`` (``mrl/configs/continuous_off_policy.py``); ``BASELINES`` holds the OpenAI Baselines
+settings (``baselines/her/experiment/config.py``) that the SPLID paper's Figure 3 compares against."""
 
 from __future__ import annotations
 
@@ -10,38 +12,56 @@ from splid_jax.common.fields import field
 
 @dataclasses.dataclass(frozen=True)
 class HerConfig:
-    """HER's own settings; defaults are OpenAI Baselines' (``baselines/her/experiment/config.py``).
-    Normalised inputs are clipped to +-``networks.CLIP_NORMALISED`` (5, Baselines' norm_clip)."""
+    """HER's own settings. Normalised inputs are clipped to +-``networks.CLIP_NORMALISED`` (5, Baselines'
+    norm_clip). A sampled goal is the transition's own with weight 1, a later achieved goal of its episode
+    with weight ``replay_k`` and a stored episode's desired goal with weight ``actual_k``."""
 
-    replay_k: int = field(4, "future strategy: k relabelled goals per original one (relabel probability 1 - 1/(1+k))")
-    gamma: float = field(0.98, "discount; Baselines uses 1 - 1/T, 0.98 for the 50-step episodes")
-    hidden: tuple[int, ...] = field((256, 256, 256), "hidden layer widths of the actor and of the critic (ReLU)")
+    replay_k: int = field(2, "relabelled goals per real one drawn from later achieved goals of the same episode")
+    actual_k: int = field(
+        2,
+        "relabelled goals per real one drawn from the desired goals of any stored episode (mrl's 'actual'; "
+        "futureactual_2_2 is replay_k=2, actual_k=2; Baselines' future_4 is replay_k=4, actual_k=0)",
+    )
+    actual_warm_up: int = field(
+        25_000, "stored transitions before 'actual' goals are drawn; until then their share goes to future goals"
+    )
+    gamma: float = field(0.98, "discount; 0.98 for the 50-step episodes (Baselines: 1 - 1/T)")
+    hidden: tuple[int, ...] = field((512, 512, 512), "hidden layer widths of the actor and of the critic (ReLU)")
+    layer_norm: bool = field(True, "LayerNorm after each hidden layer of the actor and the critic")
     actor_lr: float = field(1e-3, "Adam learning rate of the actor")
     critic_lr: float = field(1e-3, "Adam learning rate of the critic")
-    batch_size: int = field(
-        2048,
-        "transitions per gradient step: Baselines averages the gradients of 8 MPI workers' batches of 256, "
-        "2048 in effect",
+    batch_size: int = field(2000, "transitions per gradient step")
+    buffer_transitions: int = field(2_500_000, "replay capacity in transitions, stored as whole episodes (FIFO)")
+    update_every: int = field(
+        2,
+        "one gradient step per this many collected transitions, every env counted (mrl's optimize_every); "
+        "0: n_batches steps per iteration",
     )
-    buffer_transitions: int = field(1_000_000, "replay capacity in transitions, stored as whole episodes (FIFO)")
-    n_batches: int = field(40, "gradient steps per iteration (Baselines' n_batches per cycle)")
-    polyak: float = field(0.95, "target = polyak * target + (1 - polyak) * online, once per iteration")
-    action_l2: float = field(1.0, "weight of the actor's mean squared action penalty")
-    random_eps: float = field(0.3, "exploration: probability of a uniformly random action")
-    noise_eps: float = field(0.2, "exploration: std of the Gaussian noise added to the actor's action")
+    n_batches: int = field(40, "gradient steps per iteration when update_every=0 (Baselines' n_batches per cycle)")
+    target_every: int = field(
+        10, "the target networks move every this many gradient steps; 0: once per iteration, after its steps"
+    )
+    polyak: float = field(0.95, "target = polyak * target + (1 - polyak) * online, at each target update")
+    action_l2: float = field(0.01, "weight of the actor's mean squared action penalty")
+    random_eps: float = field(0.2, "exploration: probability of a uniformly random action")
+    noise_eps: float = field(0.1, "exploration: std of the Gaussian noise added to the actor's action")
+    random_transitions: int = field(10_000, "the first this many collected transitions take uniformly random actions")
+    warm_up: int = field(5_000, "no gradient step until the buffer holds this many transitions")
     norm_eps: float = field(0.01, "std floor of the observation and goal normaliser")
     clip_obs: float = field(200.0, "observations and goals are clipped to +-clip_obs before normalising")
 
     def __post_init__(self):
         object.__setattr__(self, "hidden", tuple(int(w) for w in self.hidden))
-        check(self.replay_k >= 0, "her.replay_k", self.replay_k, "an integer >= 0")
+        for name in ("replay_k", "actual_k", "actual_warm_up", "update_every", "n_batches", "target_every"):
+            check(getattr(self, name) >= 0, f"her.{name}", getattr(self, name), "an integer >= 0")
+        for name in ("random_transitions", "warm_up"):
+            check(getattr(self, name) >= 0, f"her.{name}", getattr(self, name), "an integer >= 0")
         check(0 <= self.gamma < 1, "her.gamma", self.gamma, "in [0, 1)")
         check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "her.hidden", self.hidden, "one or more widths >= 1")
         check(self.actor_lr > 0, "her.actor_lr", self.actor_lr, "> 0")
         check(self.critic_lr > 0, "her.critic_lr", self.critic_lr, "> 0")
         check(self.batch_size >= 1, "her.batch_size", self.batch_size, "an integer >= 1")
         check(self.buffer_transitions >= 1, "her.buffer_transitions", self.buffer_transitions, "an integer >= 1")
-        check(self.n_batches >= 0, "her.n_batches", self.n_batches, "an integer >= 0")
         check(0 <= self.polyak <= 1, "her.polyak", self.polyak, "in [0, 1]")
         check(self.action_l2 >= 0, "her.action_l2", self.action_l2, ">= 0")
         check(0 <= self.random_eps <= 1, "her.random_eps", self.random_eps, "in [0, 1]")
@@ -51,4 +71,36 @@ class HerConfig:
 
     @property
     def future_p(self) -> float:
-        return 1.0 - 1.0 / (1.0 + self.replay_k)
+        """The share of a batch relabelled with a later achieved goal of the same episode."""
+        return self.replay_k / (1.0 + self.replay_k + self.actual_k)
+
+    @property
+    def actual_p(self) -> float:
+        """The share of a batch relabelled with a stored episode's desired goal."""
+        return self.actual_k / (1.0 + self.replay_k + self.actual_k)
+
+    def updates_per_iteration(self, transitions: int) -> int:
+        """Gradient steps after an iteration that collected ``transitions``."""
+        return transitions // self.update_every if self.update_every else self.n_batches
+
+
+# OpenAI Baselines' DDPG+HER, the HER of the SPLID paper's Figure 3: its curves ran 8 MPI workers of 2 episodes
+# each per cycle (16 episodes, the run's num_envs) whose batches of 256 average to one step of 2048.
+BASELINES = dict(
+    replay_k=4,
+    actual_k=0,
+    actual_warm_up=0,
+    hidden=(256, 256, 256),
+    layer_norm=False,
+    batch_size=2048,
+    buffer_transitions=1_000_000,
+    update_every=0,
+    n_batches=40,
+    target_every=0,
+    action_l2=1.0,
+    random_eps=0.3,
+    noise_eps=0.2,
+    random_transitions=0,
+    warm_up=0,
+)
+BASELINES_WORKERS = 8

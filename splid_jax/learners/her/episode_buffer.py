@@ -1,5 +1,5 @@
-"""HER's replay: whole episodes in a FIFO ring, and Baselines' future strategy that samples
-transitions from them with relabelled goals."""
+"""HER's replay: whole episodes in a FIFO ring, and the relabelling that samples transitions from them
+with hindsight goals (Baselines' "future", mrl's "futureactual")."""
 
 from __future__ import annotations
 
@@ -48,27 +48,46 @@ def buffer_insert(buf: EpisodeBuffer, new: EpisodeBuffer, mask: jax.Array) -> Ep
 
 class Transitions(NamedTuple):
     obs: jax.Array  # [B, O]
-    goal: jax.Array  # [B, G] the original goal, or with probability future_p a later achieved goal
+    goal: jax.Array  # [B, G] the episode's own goal, a later achieved goal, or another episode's goal
     action: jax.Array  # [B, A]
     next_obs: jax.Array  # [B, O]
     reward: jax.Array  # [B] the task's reward of the next achieved goal for that goal
     episode: jax.Array  # [B] int32, the slot sampled
     t: jax.Array  # [B] int32, the step sampled
     future: jax.Array  # [B] int32 in [t + 1, T], where a relabelled goal was achieved
-    relabelled: jax.Array  # [B] bool
+    relabelled: jax.Array  # [B] bool, the goal is the achieved goal at ``future``
+    actual: jax.Array  # [B] bool, the goal is the desired goal of the stored episode ``other``
+    other: jax.Array  # [B] int32, a uniform filled slot
 
 
-def sample_transitions(buf: EpisodeBuffer, key: jax.Array, batch_size: int, future_p: float, reward_of) -> Transitions:
-    """Baselines' future strategy: a uniform episode and step; with probability ``future_p`` the goal
-    becomes the achieved goal of a uniform later step of the same episode; the reward is recomputed.
-    An empty buffer yields slot 0 (callers weight the loss by ``size > 0``)."""
+def sample_transitions(
+    buf: EpisodeBuffer,
+    key: jax.Array,
+    batch_size: int,
+    future_p: float,
+    reward_of,
+    actual_p: float = 0.0,
+    actual_on: jax.Array | bool = True,
+) -> Transitions:
+    """A uniform episode and step, and its goal relabelled: with probability ``future_p`` the achieved goal
+    of a uniform later step of the same episode (Baselines' and mrl's "future"), with probability ``actual_p``
+    the desired goal of a uniform stored episode (mrl's "actual"; while ``actual_on`` is False this share is
+    relabelled as "future" too), else the episode's own goal. The reward is recomputed. An empty buffer yields
+    slot 0 (callers weight the loss by ``size > 0``)."""
     T = buf.actions.shape[1]
     k_ep, k_t, k_future, k_relabel = jax.random.split(key, 4)
-    ep = jax.random.randint(k_ep, (batch_size,), 0, jnp.maximum(buf.size, 1))
+    filled = jnp.maximum(buf.size, 1)
+    ep = jax.random.randint(k_ep, (batch_size,), 0, filled)
     t = jax.random.randint(k_t, (batch_size,), 0, T)
     future = jax.random.randint(k_future, (batch_size,), t + 1, T + 1)
-    relabelled = jax.random.uniform(k_relabel, (batch_size,)) < future_p
+    # drawn only where "actual" goals can occur, so the future strategy alone draws what it always drew
+    other = jax.random.randint(jax.random.fold_in(key, 1), (batch_size,), 0, filled) if actual_p else ep
+    u = jax.random.uniform(k_relabel, (batch_size,))
+    mixed = u < future_p + actual_p
+    actual = mixed & (u >= future_p) & actual_on
+    relabelled = mixed & ~actual
     goal = jnp.where(relabelled[:, None], buf.achieved[ep, future], buf.goal[ep])
+    goal = jnp.where(actual[:, None], buf.goal[other], goal)
     return Transitions(
         obs=buf.obs[ep, t],
         goal=goal,
@@ -79,4 +98,6 @@ def sample_transitions(buf: EpisodeBuffer, key: jax.Array, batch_size: int, futu
         t=t,
         future=future,
         relabelled=relabelled,
+        actual=actual,
+        other=other,
     )

@@ -1,7 +1,8 @@
-"""DDPG + HER (Andrychowicz et al. 2017) with the OpenAI Baselines settings, as an
-``learners.base.Algorithm``: one iteration is one Baselines cycle (explore ``num_envs`` episodes in
-parallel, store them whole, ``n_batches`` gradient steps on future-relabelled transitions, one
-Polyak update of the targets), scanned ``eval_every`` times per compiled chunk.
+"""DDPG + HER (Andrychowicz et al. 2017) as an ``learners.base.Algorithm``: one iteration explores
+``num_envs`` episodes in parallel, stores them whole, and takes its gradient steps on relabelled
+transitions (one per ``update_every`` collected transitions as mrl, or ``n_batches`` as a Baselines
+cycle), the target networks moving every ``target_every`` steps or once after them; ``eval_every``
+iterations are scanned per compiled chunk. ``HerConfig`` holds the settings of either protocol.
 
 The actor is a ``networks.Policy`` (ReLU, tanh output) whose state also holds the observation and
 goal normaliser, so evaluation, rollouts and checkpoints read it as they read SPLID's policy."""
@@ -34,6 +35,11 @@ def td_target(reward: jax.Array, next_q: jax.Array, gamma: float, low: float, hi
     return jnp.clip(reward + gamma * next_q, low, high)
 
 
+def _pick(which: jax.Array, new, old):
+    """``new`` where ``which`` holds, else ``old`` (pytrees of one structure)."""
+    return jax.tree_util.tree_map(lambda a, b: jnp.where(which, a, b), new, old)
+
+
 @struct.dataclass
 class HerState:
     policy: PolicyState  # the online actor and the shared observation/goal normaliser (acts and evaluates)
@@ -63,12 +69,14 @@ class HER(Chunked):
         )
         self.env, self.cfg, self.her = env, cfg, her
         self.capacity = her.buffer_transitions // T
+        self.n_updates = her.updates_per_iteration(cfg.num_envs * T)
+        nets = dict(hidden=her.hidden, activation="relu", layer_norm=her.layer_norm)
         self.policy = Policy(
-            net=MLP(hidden=her.hidden, action_size=env.action_size, activation="relu", tanh_output=True),
+            net=MLP(**nets, action_size=env.action_size, tanh_output=True),
             in_size=env.obs_size + env.goal_size,
             normalise=True,
         )
-        self.critic = MLP(hidden=her.hidden, action_size=1, activation="relu")
+        self.critic = MLP(**nets, action_size=1)
         self.actor_opt = optax.adam(her.actor_lr)
         self.critic_opt = optax.adam(her.critic_lr)
         # The returns the task's sparse reward allows: Baselines' [-1/(1-gamma), 0] under the Fetch
@@ -107,11 +115,14 @@ class HER(Chunked):
         x = jnp.concatenate([self._clip(obs), self._clip(goal)], axis=-1)
         return running_statistics.normalize(x, normaliser, max_abs_value=CLIP_NORMALISED)
 
-    def explore(self, pstate: PolicyState, key: jax.Array) -> tuple[EpisodeBuffer, jax.Array, jax.Array]:
-        """``num_envs`` episodes with Baselines' exploration: the actor plus N(0, noise_eps^2), clipped,
-        replaced by a uniform action with probability random_eps. Returns the episodes (batch-major),
-        their validity (no NaN) and whether each succeeded at any step."""
+    def explore(
+        self, pstate: PolicyState, key: jax.Array, random_p: jax.Array | float | None = None
+    ) -> tuple[EpisodeBuffer, jax.Array, jax.Array]:
+        """``num_envs`` episodes: the actor plus N(0, noise_eps^2), clipped, replaced by a uniform action
+        with probability ``random_p`` (default random_eps). Returns the episodes (batch-major), their
+        validity (no NaN) and whether each succeeded at any step."""
         env, her, n = self.env, self.her, self.cfg.num_envs
+        random_p = her.random_eps if random_p is None else random_p
         k_reset, k_steps = jax.random.split(key)
         start = jax.vmap(env.reset)(jax.random.split(k_reset, n))
 
@@ -120,7 +131,7 @@ class HER(Chunked):
             mean = self.policy.net.apply(pstate.params, self._inputs(pstate.normaliser, state.obs, state.desired_goal))
             action = jnp.clip(mean + her.noise_eps * jax.random.normal(k_noise, mean.shape), -1.0, 1.0)
             uniform = jax.random.uniform(k_uniform, mean.shape, minval=-1.0, maxval=1.0)
-            action = jnp.where(jax.random.bernoulli(k_coin, her.random_eps, (n, 1)), uniform, action)
+            action = jnp.where(jax.random.bernoulli(k_coin, random_p, (n, 1)), uniform, action)
             nxt = step_batch(env, state, action)
             return nxt, (nxt.obs, nxt.achieved_goal, action, nxt.success)
 
@@ -142,7 +153,7 @@ class HER(Chunked):
         """As Baselines: statistics of (obs, goal) over num_envs * T relabelled transitions of the new
         episodes; episodes with a NaN carry no weight."""
         n = episodes.obs.shape[0] * self.env.episode_length
-        tr = sample_transitions(episodes, key, n, self.her.future_p, self.env.reward_of)
+        tr = sample_transitions(episodes, key, n, self.her.future_p, self.env.reward_of)  # the future strategy
         x = jnp.concatenate([self._clip(tr.obs), self._clip(tr.goal)], axis=-1)
         w = valid[tr.episode].astype(jnp.float32)
         x = jnp.where(w[:, None] > 0, x, 0.0)
@@ -176,51 +187,84 @@ class HER(Chunked):
         a_loss, a_grad = jax.value_and_grad(actor_loss)(actor)
         return c_loss, a_loss, jnp.mean(q_data), c_grad, a_grad
 
+    def _moved_targets(self, hs: HerState) -> HerState:
+        step = 1.0 - self.her.polyak
+        return hs.replace(
+            target_actor=optax.incremental_update(hs.policy.params, hs.target_actor, step),
+            target_critic=optax.incremental_update(hs.critic, hs.target_critic, step),
+        )
+
+    def warm(self, buffer: EpisodeBuffer) -> jax.Array:
+        """Whether the buffer holds enough to learn from: an episode, and ``warm_up`` transitions."""
+        return (buffer.size > 0) & (buffer.size * self.env.episode_length >= self.her.warm_up)
+
     def train_step(self, hs: HerState, batch: tuple[Transitions, jax.Array]) -> tuple[HerState, dict]:
         """One gradient step of critic and actor, both from the same batch at the same parameters (as
-        Baselines computes them in one pass)."""
+        Baselines computes them in one pass); none before the buffer is ``warm``."""
         tr, target = batch
         c_loss, a_loss, q_mean, c_grad, a_grad = self.losses(hs.policy.params, hs.critic, hs.policy, tr, target)
-        filled = (hs.buffer.size > 0).astype(jnp.float32)  # no step on an empty buffer
-        c_grad, a_grad = jax.tree_util.tree_map(lambda g: g * filled, (c_grad, a_grad))
         c_upd, critic_opt = self.critic_opt.update(c_grad, hs.critic_opt, hs.critic)
         a_upd, actor_opt = self.actor_opt.update(a_grad, hs.actor_opt, hs.policy.params)
+        old = (hs.critic, hs.critic_opt, hs.policy.params, hs.actor_opt)
+        new = (
+            optax.apply_updates(hs.critic, c_upd),
+            critic_opt,
+            optax.apply_updates(hs.policy.params, a_upd),
+            actor_opt,
+        )
+        critic, critic_opt, actor, actor_opt = _pick(self.warm(hs.buffer), new, old)
         hs = hs.replace(
-            critic=optax.apply_updates(hs.critic, c_upd),
-            critic_opt=critic_opt,
-            policy=hs.policy.replace(params=optax.apply_updates(hs.policy.params, a_upd)),
-            actor_opt=actor_opt,
+            critic=critic, critic_opt=critic_opt, policy=hs.policy.replace(params=actor), actor_opt=actor_opt
         )
         return hs, {"critic_loss": c_loss, "actor_loss": a_loss, "q_mean": q_mean}
 
+    def draw(self, hs: HerState, key: jax.Array, n: int) -> Transitions:
+        """``n`` batches, each from its own key as one at a time would draw it."""
+        her, T = self.her, self.env.episode_length
+        actual_on = hs.buffer.size * T >= her.actual_warm_up
+
+        def one(k):
+            return sample_transitions(
+                hs.buffer, k, her.batch_size, her.future_p, self.env.reward_of, her.actual_p, actual_on
+            )
+
+        return jax.vmap(one)(jax.random.split(key, n))
+
     def updates(self, hs: HerState, key: jax.Array) -> tuple[HerState, dict]:
-        """A cycle's ``n_batches`` gradient steps. The buffer does not change between them, so their batches
-        are drawn at once (each from its own key, as one at a time would draw it) with their TD targets, and
-        the scan carries only the steps."""
+        """An iteration's ``n_updates`` gradient steps. The buffer does not change between them, so their
+        batches are drawn at once. Where the targets stay fixed over them (``target_every`` 0, Baselines),
+        so do their TD targets, computed in one pass before the steps; otherwise each step computes its own
+        and the targets move every ``target_every`` steps."""
         her = self.her
+        batches = self.draw(hs, key, self.n_updates)
+        if not her.target_every:
+            return jax.lax.scan(self.train_step, hs, (batches, self.td_targets(hs, batches)))
 
-        def draw(k):
-            return sample_transitions(hs.buffer, k, her.batch_size, her.future_p, self.env.reward_of)
+        def step(hs, inputs):
+            i, tr = inputs
+            hs, losses = self.train_step(hs, (tr, self.td_targets(hs, tr)))
+            move = ((i + 1) % her.target_every == 0) & self.warm(hs.buffer)
+            moved = self._moved_targets(hs)
+            targets = _pick(move, (moved.target_actor, moved.target_critic), (hs.target_actor, hs.target_critic))
+            return hs.replace(target_actor=targets[0], target_critic=targets[1]), losses
 
-        batches = jax.vmap(draw)(jax.random.split(key, her.n_batches))
-        return jax.lax.scan(self.train_step, hs, (batches, self.td_targets(hs, batches)))
+        return jax.lax.scan(step, hs, (jnp.arange(self.n_updates), batches))
 
     def iteration(self, hs: HerState, hyper) -> tuple[HerState, dict]:
-        """One Baselines cycle."""
+        """Explore, store, update the normaliser, then the gradient steps (and the targets after them where
+        they move once per iteration)."""
         key, k_explore, k_norm, k_train = jax.random.split(hs.key, 4)
-        episodes, valid, success = self.explore(hs.policy, k_explore)
+        collected = hs.iteration * (self.cfg.num_envs * self.env.episode_length)
+        random_p = jnp.where(collected < self.her.random_transitions, 1.0, self.her.random_eps)
+        episodes, valid, success = self.explore(hs.policy, k_explore, random_p)
         hs = hs.replace(
             buffer=buffer_insert(hs.buffer, episodes, valid),
             policy=self.update_normaliser(hs.policy, episodes, valid, k_norm),
         )
         hs, losses = self.updates(hs, k_train)
-        step = 1.0 - self.her.polyak
-        hs = hs.replace(
-            target_actor=optax.incremental_update(hs.policy.params, hs.target_actor, step),
-            target_critic=optax.incremental_update(hs.critic, hs.target_critic, step),
-            key=key,
-            iteration=hs.iteration + 1,
-        )
+        if not self.her.target_every:
+            hs = self._moved_targets(hs)
+        hs = hs.replace(key=key, iteration=hs.iteration + 1)
         metrics = {k: jnp.mean(v) for k, v in losses.items()}
         metrics["losses_finite"] = jnp.all(jnp.isfinite(losses["critic_loss"]) & jnp.isfinite(losses["actor_loss"]))
         metrics["explore_success"] = jnp.mean(success)

@@ -22,7 +22,12 @@ ARGS = {
     "splid": BC,
     "gcsl": BC,
     "pchid": [*BC, "--pchid-every", "1"],  # a fixed schedule: the default follows --iterations
-    "her": ["--num-envs", "4", "--her-options", "batch_size=32,n_batches=2,hidden=16,16,buffer_transitions=2000"],
+    "her": [
+        "--num-envs",
+        "4",
+        "--her-options",
+        "batch_size=32,update_every=0,n_batches=2,hidden=16,16,buffer_transitions=2000",
+    ],
     "es": ["--hidden", "16,16", "--es-options", "population=8"],
 }
 SCHEMA = ("iteration", "episodes", "env_steps", "select_steps", "eval_success", "eval_success_final", "eval_return",
@@ -101,25 +106,25 @@ def test_options_reach_the_config_with_their_types():
     assert (her.hidden, her.batch_size, her.polyak) == ((16, 16), 32, 0.9)
     es = TrainConfig(algo="es", es_options="population=8,episodes_per_member=2,antithetic=false")
     assert es.learner_config().antithetic is False and es.num_envs == 16  # episodes per generation
-    assert TrainConfig(algo="her").learner_config().batch_size == 2048  # Baselines: 8 workers x 256
+    assert TrainConfig(algo="her").learner_config().batch_size == 2000  # mrl's
 
 
 def test_her_takes_its_own_defaults_on_fetch_tasks_only():
     push = TrainConfig(env="push", algo="her")
-    assert (push.num_envs, push.eval_every, push.iterations * push.num_envs) == (16, 50, 20_000)
+    assert (push.num_envs, push.eval_every, push.iterations * push.num_envs) == (8, 25, 20_000)
     assert TrainConfig(env="push").num_envs == 125 and TrainConfig(env="point", algo="her").num_envs == 32
     assert TrainConfig(env="push", algo="her", num_envs=32).num_envs == 32  # given values win
     assert push.env_overrides() == {} and TrainConfig(env="push").env_options == ""
     given = TrainConfig(env="push", algo="her", env_options="finger=box,solver_loops=loops")
     assert given.env_overrides() == {"finger": "box", "solver_loops": "loops"}  # option by option, given ones win
-    carry = TrainConfig(env="pick_and_place", algo="her").env_overrides()  # the task's own options stay
-    assert carry == {"grasped_starts": 0.5}
+    carry = TrainConfig(env="pick_and_place", algo="her").env_overrides()  # mrl's: the standard starts
+    assert carry == {"grasped_starts": 0}
 
 
 def test_help_lists_each_learners_fields_and_defaults(capsys):
     with pytest.raises(SystemExit):
         main(["--help"])
     text = " ".join(capsys.readouterr().out.split())
-    assert "batch_size=2048 (" in text and "replay_k=4 (" in text and "population=256 (" in text
-    assert "her on reach, push, slide, pick_and_place: 16" in text
-    assert "her on push: 1250" in text
+    assert "batch_size=2000 (" in text and "replay_k=2 (" in text and "population=256 (" in text
+    assert "her on reach, push, slide, pick_and_place: 8" in text
+    assert "her on push, pick_and_place: 2500" in text and "her on slide: 6250" in text

@@ -37,7 +37,11 @@ def two_chunks(learner, chunk):
 def test_training_and_report_as_two_programs_give_the_one_programs_chunk():
     for learner in (
         Trainer(envs.make("point"), TrainConfig(**CFG)),
-        HER(envs.make("point"), TrainConfig(**CFG, algo="her"), HerConfig(n_batches=4, batch_size=32)),
+        HER(
+            envs.make("point"),
+            TrainConfig(**CFG, algo="her"),
+            HerConfig(update_every=0, n_batches=4, batch_size=32, hidden=(32, 32)),
+        ),
     ):
         fns = programs.parts(learner, stacked=False)
         assert len(fns) == 2

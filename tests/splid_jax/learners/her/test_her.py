@@ -15,12 +15,12 @@ from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 from splid_jax.learners.her import episode_buffer
 from splid_jax.learners.her import learner as her_mod
-from splid_jax.learners.her.config import HerConfig
+from splid_jax.learners.her.config import BASELINES, HerConfig
 from splid_jax.learners.her.learner import HER
 from tests.helpers import random_policy_success, with_counted_jit
 
 CFG = dict(env="point", num_envs=16, iterations=150, eval_every=25, eval_episodes=256)
-HER_CFG = dict(hidden=(64, 64, 64), buffer_transitions=100_000, batch_size=256)
+HER_CFG = dict(BASELINES, hidden=(64, 64, 64), buffer_transitions=100_000, batch_size=256)
 CHUNKS = 6  # 150 cycles, 2,400 episodes
 # The suite compiles at LLVM's level 0 (conftest.CPU_COMPILE_FLAGS), right for programs run once or twice;
 # this chunk runs 9 times here, 2.5x faster at level 2 for 3 s more compiling (about 20 s less in all).
@@ -53,7 +53,7 @@ def other_seed(her):
     return run_chunks(her, 1, 1)
 
 
-sample = jax.jit(episode_buffer.sample_transitions, static_argnums=(2, 3, 4))
+sample = jax.jit(episode_buffer.sample_transitions, static_argnums=(2, 3, 4, 5))
 
 
 def coded_buffer(episodes=8, filled=6, T=5):
@@ -74,7 +74,7 @@ def coded_buffer(episodes=8, filled=6, T=5):
 
 def test_future_relabelling_draws_later_achieved_goals_of_the_same_episode():
     env, buf, T, n = PointFourRooms(), coded_buffer(), 5, 20_000
-    future_p = HerConfig(replay_k=4).future_p
+    future_p = HerConfig(replay_k=4, actual_k=0).future_p
     tr = jax.device_get(sample(buf, jax.random.PRNGKey(0), n, future_p, env.reward_of))
     ep, t = tr.episode, tr.t
     assert ep.min() == 0 and ep.max() == 5  # only filled slots
@@ -88,7 +88,7 @@ def test_future_relabelling_draws_later_achieved_goals_of_the_same_episode():
     np.testing.assert_array_equal(tr.goal[~rel], np.stack([ep, -np.ones(n)], -1)[~rel])
     assert (tr.future >= t + 1).all() and (tr.future <= T).all()
     np.testing.assert_array_equal(np.unique(tr.future[t == 0]), np.arange(1, T + 1))  # every later step
-    none = sample(buf, jax.random.PRNGKey(1), 1000, HerConfig(replay_k=0).future_p, env.reward_of)
+    none = sample(buf, jax.random.PRNGKey(1), 1000, HerConfig(replay_k=0, actual_k=0).future_p, env.reward_of)
     assert not np.asarray(none.relabelled).any()
 
 
@@ -154,7 +154,7 @@ def test_buffer_keeps_only_valid_episodes_first_in_first_out():
 
 def test_exploration_without_noise_takes_the_actors_action():
     env, cfg = PointFourRooms(max_episode_steps=5), TrainConfig(**{**CFG, "num_envs": 4})
-    quiet = HER(env, cfg, HerConfig(**HER_CFG, random_eps=0.0, noise_eps=0.0))
+    quiet = HER(env, cfg, HerConfig(**{**HER_CFG, "random_eps": 0.0, "noise_eps": 0.0}))
     state = quiet.init(jax.random.PRNGKey(3))
     episodes, valid, _ = jax.jit(quiet.explore)(state.policy, jax.random.PRNGKey(4))
     assert bool(valid.all())
@@ -196,3 +196,77 @@ def test_config_errors_name_the_field():
         HerConfig(polyak=1.5)
     with pytest.raises(InvalidConfig, match="her.buffer_transitions"):
         HER(PointFourRooms(), TrainConfig(**CFG), HerConfig(buffer_transitions=10))
+
+
+def test_futureactual_mix_draws_a_fifth_real_two_fifths_future_two_fifths_stored_goals():
+    env, buf, n = PointFourRooms(), coded_buffer(), 20_000
+    mix = HerConfig(replay_k=2, actual_k=2)
+    tr = jax.device_get(sample(buf, jax.random.PRNGKey(6), n, mix.future_p, env.reward_of, mix.actual_p))
+    real = ~tr.relabelled & ~tr.actual
+    for share, expected in ((real, 0.2), (tr.relabelled, 0.4), (tr.actual, 0.4)):
+        assert abs(share.mean() - expected) < 0.015, (share.mean(), expected)
+    assert not (tr.relabelled & tr.actual).any()
+    # "actual": the desired goal of a uniformly drawn filled slot, any episode's, not only the sampled one's
+    np.testing.assert_array_equal(tr.goal[tr.actual], np.stack([tr.other, -np.ones(n)], -1)[tr.actual])
+    assert set(np.unique(tr.other[tr.actual])) == set(range(6))
+    assert (tr.other[tr.actual] != tr.episode[tr.actual]).mean() > 0.7
+    np.testing.assert_array_equal(tr.goal[real], np.stack([tr.episode, -np.ones(n)], -1)[real])
+    # before the warm-up of stored transitions, the stored goals' share goes to future goals
+    early = jax.device_get(sample(buf, jax.random.PRNGKey(6), n, mix.future_p, env.reward_of, mix.actual_p, False))
+    assert not early.actual.any() and abs(early.relabelled.mean() - 0.8) < 0.015
+
+
+def _her(num_envs=4, **her):
+    return HER(PointFourRooms(), TrainConfig(**{**CFG, "num_envs": num_envs}), HerConfig(**her))
+
+
+def test_gradient_steps_per_collected_transition():
+    key = jax.random.PRNGKey(0)
+    for update_every, expected in ((2, 100), (5, 40), (0, 7)):  # 4 envs x 50 steps; 0: n_batches per iteration
+        her = _her(update_every=update_every, n_batches=7, hidden=(8,), batch_size=4, buffer_transitions=500)
+        _, losses = jax.eval_shape(her.updates, jax.eval_shape(her.init, key), key)
+        assert her.n_updates == expected and losses["critic_loss"].shape == (expected,)
+
+
+def test_layer_norm_in_both_networks_where_configured():
+    def norms(params):
+        return [k for k in jax.tree_util.tree_flatten_with_path(params)[0] if "LayerNorm" in jax.tree_util.keystr(k[0])]
+
+    for layer_norm, count in ((True, 2 * 2 * 3), (False, 0)):  # scale and bias of 3 hidden layers, 2 networks
+        her = _her(layer_norm=layer_norm, hidden=(8, 8, 8), buffer_transitions=500)
+        state = jax.eval_shape(her.init, jax.random.PRNGKey(0))
+        assert len(norms(state.policy.params)) + len(norms(state.critic)) == count
+
+
+def test_targets_move_every_target_every_steps_only_once_warm():
+    her = _her(
+        update_every=0, n_batches=10, target_every=5, warm_up=0, hidden=(8,), batch_size=8, buffer_transitions=500
+    )
+    state = her.init(jax.random.PRNGKey(1))
+    episodes, valid, _ = jax.jit(her.explore)(state.policy, jax.random.PRNGKey(2))
+    cold = state.replace(buffer=episode_buffer.buffer_insert(state.buffer, episodes, valid[:0].any() & valid))
+    warm = state.replace(buffer=episode_buffer.buffer_insert(state.buffer, episodes, valid))
+    for start, moves in ((cold, False), (warm, True)):
+        after, _ = jax.jit(her.updates)(start, jax.random.PRNGKey(3))
+        leaf = lambda s: jax.tree_util.tree_leaves(s.target_critic)[-1]  # noqa: E731
+        assert (not np.array_equal(leaf(after), leaf(start))) == moves
+        assert (
+            not np.array_equal(after.critic["params"]["Dense_0"]["kernel"], start.critic["params"]["Dense_0"]["kernel"])
+        ) == moves
+
+
+def test_the_mrl_preset_learns_the_point_task_and_not_without_its_updates():
+    """mrl's settings scaled to the CPU (narrower nets, smaller batches, a step per 8 transitions, warm-ups
+    shortened in proportion); with no gradient step the policy stays at its initial one."""
+    small = dict(hidden=(64, 64), batch_size=256, buffer_transitions=100_000, update_every=8)
+    small.update(random_transitions=2_000, warm_up=1_000, actual_warm_up=5_000)
+    cfg = TrainConfig(**{**CFG, "num_envs": 8, "iterations": 100, "eval_every": 25})
+    baseline = random_policy_success(envs.make("point"))
+    for update_every, learns in ((8, True), (10**6, False)):
+        her = HER(envs.make("point"), cfg, HerConfig(**{**small, "update_every": update_every}))
+        state, metrics = her.init(jax.random.PRNGKey(0)), None
+        chunk = jax.jit(her.chunk)
+        for _ in range(4):
+            state, metrics = chunk(state, her.hyper())
+        success = float(metrics["eval_success_final"])
+        assert (success > baseline + 0.25) == learns, (success, baseline, update_every)
