@@ -2,7 +2,7 @@
 program per geom pair, and on a GPU as one Pallas kernel per pair group.
 
 Why: after the constraint solve (``envs/fused_solver.py``), collision is the largest part of a Push control step on a
-GPU (about 530 small kernels of its 2,600 at 16 envs before the solve kernel; experiments/NOTES.md, "What a control step
+GPU (a fifth of its small kernels at the learners' batch sizes; experiments/NOTES.md, "What a control step
 launches"), and of MJX's collision for Push the box-box pair (the finger block against the cube) is 1,111 of its 1,612
 traced equations. The arithmetic is MJX's: the separating-axis test over the 6 + 6 face normals and 9 edge crosses, the
 reference and incident faces, their clipping, the choice of four manifold points, the edge-contact rule; for a plane,

@@ -2,9 +2,9 @@
 
 Why: one env per program (the Pallas kernels in ``envs/fused_*.py``) wins where a step's envs are few, the
 GPU's time going to launches rather than arithmetic, and loses at thousands of envs, where XLA's batched
-operations fill the GPU better (BENCHMARKS.md, "The solve kernel at large batches"). A step runs at both sizes
-in one program (exploration at 125 envs, SELECT's replays at thousands), and the function being batched does
-not see its batch; ``vmap`` does, so the choice is made in a custom batching rule.
+operations fill the GPU better (experiments/NOTES.md, "Physics kernels, HER's updates and the host loop"). A step
+runs at both sizes in one program (exploration at 125 envs, SELECT's replays at thousands), and the function being
+batched does not see its batch; ``vmap`` does, so the choice is made in a custom batching rule.
 """
 
 from __future__ import annotations

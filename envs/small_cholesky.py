@@ -3,11 +3,9 @@
 Why: an MJX step of a Fetch-style task factors and solves a dense nv x nv system seven times per
 substep (the mass matrix, the implicit-damping Euler update, and the Newton solver's Hessian at its
 start and at each iteration), each through ``jax.scipy.linalg.cho_factor`` / ``cho_solve``. Under
-``vmap`` on a GPU those become batched cuSOLVER / cuBLAS calls that are slow for such tiny matrices:
-65,536 9 x 9 factor-and-solves took 0.388 ms on an H200, against 0.053 ms for the same arithmetic
-unrolled here, which XLA fuses into element-wise kernels (``experiments/bench_cholesky.py``). Push
-then runs 1.65x the control steps per second on an H200 (``BENCHMARKS.md``, "Throughput: task
-physics"; ``experiments/NOTES.md``, 2026-11-23).
+``vmap`` on a GPU those become batched cuSOLVER / cuBLAS calls that are slow for such tiny matrices,
+several times slower than the same arithmetic unrolled here, which XLA fuses into element-wise kernels,
+and Push's step with them (``experiments/NOTES.md``, "Unrolled small Cholesky solves").
 It is the same algorithm (the Cholesky-Banachiewicz order), so results agree with the library's to
 float rounding.
 
@@ -79,8 +77,8 @@ def cho_factor(a, lower: bool = False, overwrite_a: bool = False, check_finite: 
     if not _unrolled(a):
         return _LIBRARY[0](a, lower=lower, overwrite_a=overwrite_a, check_finite=check_finite)
     # The barrier makes XLA compute the matrix once, before the factorisation's fused kernel, instead of
-    # fusing its producer in: Push substep 4.65 -> 4.42 ms, its Newton solve 3.22 -> 2.74 ms (H200,
-    # 65,536 envs, 2026-11-23). The same barrier on the outputs made the step 6.6x slower.
+    # fusing its producer in, which made the substep and its Newton solve faster. The same barrier on the outputs
+    # made the step several times slower.
     low = lower_factor(jax.lax.optimization_barrier(jnp.asarray(a)))
     return (low if lower else low.T), lower
 

@@ -64,7 +64,7 @@ FINGER_MASS = 1.0
 # "reference" as the reference's joints, whose 4 kg fingers carry an armature of 100 and a damping of 1000
 # (about 17 rad/s, underdamped: they close in about 0.1 s); "fast" 1 kg fingers, critically damped, without
 # armature (173 rad/s), which slam shut at up to about 8 m/s and under exploration noise throw the cube
-# (`experiments/random_lift.py`).
+# (experiments/NOTES.md, "PickAndPlace's fingers").
 FINGER_DRIVES = ("reference", "fast")
 REFERENCE_FINGER_INERTIA = 104.0  # kg along the joint: the reference finger's 4 kg and its armature of 100
 REFERENCE_FINGER_DAMPING = 1000.0

@@ -130,7 +130,8 @@ class _FetchTask(GoalEnv):
     # (fused; on a GPU only: gpu-fused; envs/fused_collision.py): the same contacts up to MJX's float ties
     collision: str = experimental("mjx", numerics_only=True)
     # GPU warps per env in the physics kernels above (Triton's default is 4): an env's solve is a chain of small
-    # reductions, which one warp runs without crossing warps (BENCHMARKS.md, "The physics kernels at one warp per env")
+    # reductions, which one warp runs without crossing warps (experiments/NOTES.md, "Physics kernels, HER's updates
+    # and the host loop")
     kernel_warps: int = experimental(1, numerics_only=True)
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")

@@ -35,7 +35,7 @@ TASKS = ("push", "slide", "pick_and_place", "reach")
 
 def rollout_fn(env, controller, episodes: int):
     """A jitted ``key -> per-episode arrays`` running ``episodes`` scripted episodes in lock step (the
-    achieved goal after every step too, for ``experiments/strike_duration.py``)."""
+    achieved goal after every step too, for the strike-duration study, ``experiments/NOTES.md``)."""
     horizon = env.episode_length
 
     def one(key):

@@ -28,9 +28,9 @@ HELP = """\
 fig3: SPLID, GCSL, PCHID, HER, ES and SPLID without SELECT, success at any step and at the final step
       (GCSL pairs each step with the episode's last state, as the paper describes it: --set gcsl.gcsl_relabel=future
       for the original's future states).
-fig4: SPLID with H in 1, 2, 4, 8, 16 (one sweep; every member replays at the largest H's cost: on an H100
-      Slide's 25 members took 3.5x the time per member of Figure 5's at H = 8; --values subsets joined
-      with --merge run each at its own cost).
+fig4: SPLID with H in 1, 2, 4, 8, 16 (one sweep; every member replays at the largest H's cost, so a
+      member takes several times as long as at H = 8 alone; --values subsets joined with --merge run
+      each at its own cost).
 fig5: SPLID with sigma in 0.25, 0.5, 1, 2 (one sweep).
 fig6: average return of SPLID with and without SELECT.
 fig8, fig9: SPLID and GCSL, average return (the paper's Figure 8) and success (Figure 9) from the same

@@ -1,9 +1,9 @@
 """Training a figure's methods at once, one process each (``python -m splid_jax.figures fig3 --side-by-side``).
 
 Why: at the sizes the methods run (16 to 640 envs) each program is a chain of small kernels that leaves most of a
-GPU idle. Under CUDA MPS the processes' kernels run on the GPU together: Figure 3's six methods on Push at 100,000
-episodes shared one H100 so, where in turn they add up (BENCHMARKS.md, "Baselines"). Without MPS a GPU runs one
-process's kernels at a time, and side by side takes as long as in turn.
+GPU idle. Under CUDA MPS the processes' kernels run on the GPU together, so the figure takes about as long as its
+slowest method instead of their sum (BENCHMARKS.md, "Figure 3 on Push"). Without MPS a GPU runs one process's kernels
+at a time, and side by side takes as long as in turn.
 
 The parent starts one child per method (``python -m splid_jax.figures.side_by_side OUT METHOD``), each training
 its sweep as ``runs.train`` would, its output in OUT/logs/METHOD.log; only the parent writes OUT/figure.json. The

@@ -6,9 +6,8 @@ resumes bit for bit. The state's size is checked against the device's memory bef
 built, and the chunk's intermediates once it is traced; the chunk is compiled once, a learner's
 training and report as two programs side by side (``programs``), timed apart from the first chunk.
 While XLA compiles, the keys, the settings and the initial state are built on the device in a thread
-(built beside the trace, they slowed it: 12.8 s against 7.0 on one H100), and on one process each checkpoint is
-written while the next chunk runs (Push's state in 0.2 to 0.3 s on a GPU host, five HER seeds' in
-about 2 s on a 2-core CPU).
+(built beside the trace, they slowed it), and on one process each checkpoint is written while the next chunk
+runs, so neither waits on the other (experiments/NOTES.md, "The host loop's overlaps").
 
 A signal stops the run at any moment with its newest whole state checkpointed (``signals``); the run
 directory's files are ``run_files``', the memory check ``memory``'s, a sweep split over devices

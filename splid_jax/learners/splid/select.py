@@ -43,7 +43,8 @@ def num_candidates(episode_length: int, max_horizon: int, num_envs: int) -> int:
 def num_lanes(episode_length: int, num_envs: int, lanes: float, max_horizon: int) -> int:
     """Parallel replay lanes: ``lanes`` times the T x N explored steps, at most one per candidate. Above 1
     the candidates of one explored step replay side by side, in fewer rounds of the queue: a GPU steps a
-    wider batch in little more time (Push's chunk 1.06x at 2 on one H100; slower at 4)."""
+    wider batch in little more time, until the batch fills it (experiments/NOTES.md, "SELECT's lanes above
+    one per explored step")."""
     steps = episode_length * num_envs
     return max(1, min(max_horizon * steps, int(round(lanes * steps))))
 

@@ -1,1 +1,0 @@
-python -m splid_jax.sweep --env push --seed 1000 --seeds 3 --iterations 800 --buffer-size 200000 --vary bc_reuse=0,50 --vary buffer_window=50000,200000 --checkpoint-every 0 --run-dir /tmp/bg/cure --quiet --compile-cache= --no-plot

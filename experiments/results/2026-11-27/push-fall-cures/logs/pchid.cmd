@@ -1,1 +1,0 @@
-python -m splid_jax.figures fig3 --env push --episodes 100000 --methods pchid --set checkpoint_every=0 --out /tmp/bg/pchid --compile-cache= --quiet
