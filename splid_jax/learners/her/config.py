@@ -47,6 +47,11 @@ class HerConfig:
     noise_eps: float = field(0.1, "exploration: std of the Gaussian noise added to the actor's action")
     random_transitions: int = field(10_000, "the first this many collected transitions take uniformly random actions")
     warm_up: int = field(5_000, "no gradient step until the buffer holds this many transitions")
+    matmul_precision: str = field(
+        "float32",
+        "precision of the gradient steps' matrix products on a GPU: float32, tensorfloat32 or bfloat16 "
+        "(jax.default_matmul_precision; the physics and the acting policy stay float32)",
+    )
     norm_eps: float = field(0.01, "std floor of the observation and goal normaliser")
     clip_obs: float = field(200.0, "observations and goals are clipped to +-clip_obs before normalising")
 
@@ -56,6 +61,10 @@ class HerConfig:
             check(getattr(self, name) >= 0, f"her.{name}", getattr(self, name), "an integer >= 0")
         for name in ("random_transitions", "warm_up"):
             check(getattr(self, name) >= 0, f"her.{name}", getattr(self, name), "an integer >= 0")
+        precisions = ("float32", "tensorfloat32", "bfloat16")
+        check(
+            self.matmul_precision in precisions, "her.matmul_precision", self.matmul_precision, " or ".join(precisions)
+        )
         check(0 <= self.gamma < 1, "her.gamma", self.gamma, "in [0, 1)")
         check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "her.hidden", self.hidden, "one or more widths >= 1")
         check(self.actor_lr > 0, "her.actor_lr", self.actor_lr, "> 0")

@@ -235,6 +235,10 @@ class HER(Chunked):
         batches are drawn at once. Where the targets stay fixed over them (``target_every`` 0, Baselines),
         so do their TD targets, computed in one pass before the steps; otherwise each step computes its own
         and the targets move every ``target_every`` steps."""
+        with jax.default_matmul_precision(self.her.matmul_precision):
+            return self._updates(hs, key)
+
+    def _updates(self, hs: HerState, key: jax.Array) -> tuple[HerState, dict]:
         her = self.her
         batches = self.draw(hs, key, self.n_updates)
         if not her.target_every:
