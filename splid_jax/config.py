@@ -204,7 +204,7 @@ class TrainConfig:
     num_devices: int = field(
         1,
         "devices to split the work across: a sweep's members, or a run's envs (splid, gcsl, pchid); "
-        "0: every device this process sees that the count divides. CPU devices only for now",
+        "0: every device this process sees that the count divides (CPU or GPU)",
     )
     run_dir: str | None = field(
         None, "directory for config.json, metrics.jsonl and checkpoints (default runs/ENV-sSEED)"

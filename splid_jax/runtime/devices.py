@@ -7,12 +7,14 @@ on one device (``groups.Groups``). A single run of a behaviour-cloning learner s
 one-device layout, and the buffer, the BC step and the parameters are replicated
 (``trainer.Trainer``).
 
-Over several processes (``splid_jax.runtime.multihost``) a sweep's mesh takes ``num_devices`` devices of
-each process, and each process runs the groups on its own; a single run stays in one process."""
+Both run on CPU and GPU devices alike. Over several processes (``splid_jax.runtime.multihost``) a
+sweep's mesh takes ``num_devices`` devices of each process, and each process runs the groups on its
+own; a single run stays in one process."""
 
 from __future__ import annotations
 
 import dataclasses
+import os
 
 import jax
 import numpy as np
@@ -48,9 +50,16 @@ class Placement:
         """A sweep's stacked state is split by member; a run's state is whole on every device."""
         return self.split() if self.axis == MEMBERS else self.replicated()
 
-    def record(self) -> dict:
-        """What a run's config.json keeps of its hardware."""
-        return {"kind": self.first.device_kind, "count": self.count, "processes": jax.process_count()}
+    def record(self, member: int | None = None, members: int = 1) -> dict:
+        """What a run's config.json keeps of its hardware: the devices' kind, count, processes and ids, and
+        for member ``member`` of a sweep of ``members`` split by member, the id of the device it ran on. Ids
+        are JAX's, counted within CUDA_VISIBLE_DEVICES, which is kept when set."""
+        ids = [d.id for d in self.mesh.devices.flat]
+        rec = {"kind": self.first.device_kind, "count": self.count, "processes": jax.process_count(), "ids": ids}
+        if member is not None and self.axis == MEMBERS:
+            rec["member_on"] = ids[member // max(members // self.count, 1)]
+        visible = os.environ.get("CUDA_VISIBLE_DEVICES")
+        return rec if visible is None or self.first.platform == "cpu" else {**rec, "cuda_visible_devices": visible}
 
 
 def place(wanted: int, size: int, axis: str) -> Placement:
@@ -71,12 +80,6 @@ def place(wanted: int, size: int, axis: str) -> Placement:
         allowed = f"a divisor of the {size // processes} {what}{each} (or 0 to choose)"
         raise InvalidConfig("num_devices", wanted, allowed)
     count = wanted or max(d for d in range(1, len(available) + 1) if size % (d * processes) == 0)
-    if count > 1 and available[0].platform != "cpu":
-        # XLA:GPU fails to compile the envs split by shard_map, and the members' per-device programs
-        # (experiments/NOTES.md, "Split work on GPUs")
-        raise InvalidConfig(
-            "num_devices", wanted, f"1 on {available[0].platform} devices for now (split work runs on CPU devices)"
-        )
     # in process order: process p holds the mesh's devices p * count onwards, so its groups' members are one block
     mesh = [[d for d in jax.devices() if d.process_index == p][:count] for p in range(processes)]
     return Placement(Mesh(np.asarray(mesh).reshape(-1), (axis,)), axis)

@@ -13,8 +13,8 @@ class Groups:
     """A sweep's members in equal groups, one per device, each group a single-device program (the
     vmapped chunk as one device runs it). Dispatch is asynchronous, so the devices run at once; a
     group computes exactly what a sweep of its members computes on one device, and no collective
-    or SPMD partitioning is involved (XLA:GPU failed to compile MJX chunks partitioned by
-    ``shard_map``, and XLA:CPU can hang in multi-device programs). Over several
+    or SPMD partitioning is involved (XLA:CPU can hang in multi-device programs). The devices' programs
+    compile at once, each in a thread. Over several
     processes each runs the groups of its own devices, and the members' metrics and checkpointed
     state are gathered between chunks (``multihost.concat``)."""
 
@@ -42,9 +42,13 @@ class Groups:
         """The whole sweep's state to checkpoint, on the host of every process, from this process's groups."""
         return checkpoint.on_host(multihost.concat(_concat(jax.device_get(groups))))
 
-    def compile(self, first, compile_on, signals: Signals):
-        rest = [signals.wait(lambda d=d: compile_on(d)) for d in list(self.devices.values())[1:]]
-        programs = [first, *rest]
+    def begin(self, compile_on, signals: Signals) -> list:
+        """The other devices' programs, each traced and compiled in a thread of its own from now, beside the
+        first device's: one after another they took the first's time once per device."""
+        return [signals.begin(lambda d=d: compile_on(d)) for d in list(self.devices.values())[1:]]
+
+    def compile(self, first, pending: list, signals: Signals):
+        programs = [first, *(signals.wait(p) for p in pending)]
 
         def run(states: tuple, hypers: tuple):
             outs = [p(s, h) for p, s, h in zip(programs, states, hypers, strict=True)]  # dispatched at once

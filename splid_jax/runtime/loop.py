@@ -281,6 +281,10 @@ class _Loop:
                   "less when the compile cache holds it)...")  # fmt: skip
         building = self.signals.begin(made)  # beside the compile: beside the trace it slowed the trace
         t0 = time.perf_counter()
+        pending = []
+        if groups is not None:  # the other devices' programs, compiled beside the first device's
+            on_device = lambda dev: programs.trace(fns, groups.on(one, dev), groups.on(groups.first(hyper_one), dev))  # noqa: E731
+            pending = groups.begin(lambda dev: programs.compile_all(on_device(dev), self.signals), self.signals)
         try:
             compiled = programs.compile_all(traced, self.signals)
         except Exception as e:  # re-raised unless it is a physics kernel's
@@ -290,9 +294,7 @@ class _Loop:
             raise InvalidConfig("env_options", cfg.env_options, hint) from e
         need = compiled.bytes_needed()
         if groups is not None:
-            on_device = lambda dev: programs.trace(fns, groups.on(one, dev), groups.on(groups.first(hyper_one), dev))  # noqa: E731
-            compiled = groups.compile(compiled, lambda dev: programs.compile_all(on_device(dev), self.signals),
-                                      self.signals)  # fmt: skip
+            compiled = groups.compile(compiled, pending, self.signals)
         self.show(f"compiled in {time.perf_counter() - t0:.1f} s (traced before it in {traced_s:.1f} s)")
         if need is not None:
             check_memory(need, "as compiled", self.device, cfg, len(self.lanes))
@@ -307,8 +309,9 @@ class _Loop:
             for lane in self.lanes if self.writes else ():
                 os.makedirs(lane.run_dir, exist_ok=True)
                 write_atomic(os.path.join(lane.run_dir, METRICS), "")
-        for lane in self.lanes if self.writes else ():
-            write_json(os.path.join(lane.run_dir, "config.json"), {**lane.to_json(), "devices": place.record()})
+        for i, lane in enumerate(self.lanes) if self.writes else ():
+            placed = place.record(i if self.stacked else None, len(self.lanes))
+            write_json(os.path.join(lane.run_dir, "config.json"), {**lane.to_json(), "devices": placed})
         if self.stacked and self.writes:
             named = [{**m.to_json(), "run_dir": os.path.basename(m.run_dir)} for m in self.lanes]
             write_json(os.path.join(cfg.run_dir, SWEEP), {"config": cfg.to_json(), "members": named})

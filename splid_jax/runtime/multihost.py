@@ -8,6 +8,7 @@ saves it: it resumes under any process layout. With one process each function is
 from __future__ import annotations
 
 import dataclasses
+import os
 import pickle
 import socket
 from collections.abc import Callable
@@ -49,6 +50,15 @@ def launch(coordinator: str | None, num_processes: int | None, process_id: int |
     return Launch(coordinator, n, process_id) if n > 1 else None
 
 
+# A process may compile for minutes (a sweep's chunk on a GPU, several devices' programs at once) or start
+# later than the others: neither may count as a dead process.
+HEARTBEAT_S = 900
+JOIN_S = 900
+# XLA:GPU otherwise splits autotuning across the processes, each waiting in its compile for the others'
+# results; process 0 alone compiles some programs (restoring a checkpoint), and each process its own groups.
+SOLO_AUTOTUNING = "--xla_gpu_shard_autotuning=false"
+
+
 def start(where: Launch | None) -> None:
     """Joins the run's processes, before any other JAX use. The CPU backend's collectives need gloo
     (the setting is read by the CPU backend only, so it is set whatever the platform)."""
@@ -57,8 +67,15 @@ def start(where: Launch | None) -> None:
     if where.process_id == 0:
         _check_port(where.coordinator)
     jax.config.update("jax_cpu_collectives_implementation", "gloo")
+    flags = os.environ.get("XLA_FLAGS", "")
+    if "xla_gpu_shard_autotuning" not in flags:
+        os.environ["XLA_FLAGS"] = f"{flags} {SOLO_AUTOTUNING}".strip()
     jax.distributed.initialize(
-        coordinator_address=where.coordinator, num_processes=where.num_processes, process_id=where.process_id
+        coordinator_address=where.coordinator,
+        num_processes=where.num_processes,
+        process_id=where.process_id,
+        initialization_timeout=JOIN_S,
+        heartbeat_timeout_seconds=HEARTBEAT_S,
     )
 
 

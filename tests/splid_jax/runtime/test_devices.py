@@ -53,7 +53,7 @@ drop = lambda rs: [{k: v for k, v in r.items() if k not in ("wall_s", "steps_per
 out["resumed"] = all(drop(read("straight", m)) == drop(read("stopped", m)) for m in ("s0", "s3"))
 out["as_one_device"] = all(drop(read("straight", m)) == drop(read("one-device", m)) for m in ("s0", "s1"))
 out["rows"] = len(read("stopped", "s3"))
-out["devices"] = json.load(open(os.path.join(root, "straight", "s0", "config.json")))["devices"]
+out["devices"] = [json.load(open(os.path.join(root, "straight", m, "config.json")))["devices"] for m in ("s0", "s3")]
 print(json.dumps(out))
 """
 
@@ -82,7 +82,8 @@ def test_a_run_split_by_envs_computes_the_one_device_iteration_to_rounding(two_d
 
 def test_a_sweep_split_by_members_computes_each_group_as_one_device_does(two_devices):
     assert two_devices["as_one_device"]
-    assert two_devices["devices"] == {"kind": "cpu", "count": 2, "processes": 1}
+    placed = {"kind": "cpu", "count": 2, "processes": 1, "ids": [0, 1]}
+    assert two_devices["devices"] == [{**placed, "member_on": 0}, {**placed, "member_on": 1}]
 
 
 def test_a_split_sweep_resumes_bit_for_bit(two_devices):

@@ -94,7 +94,9 @@ def test_only_process_0_writes_and_each_member_computes_as_in_one_process(two_pr
     for member in MEMBERS:
         assert stable(root, "p0", member) == stable(root, "one", member)
     config = json.loads((root / "p0" / MEMBERS[1] / "config.json").read_text())
-    assert config["devices"] == {"kind": "cpu", "count": 2, "processes": 2}
+    placed = config["devices"]
+    assert {k: placed[k] for k in ("kind", "count", "processes")} == {"kind": "cpu", "count": 2, "processes": 2}
+    assert len(set(placed["ids"])) == 2 and placed["member_on"] == placed["ids"][1]  # process 1's device
     for i in range(2):  # no traceback, and process 1 shows nothing
         out = (root / f"resumed-{i}.out").read_text()
         assert "Traceback" not in out and ("iter " in out) == (i == 0)
