@@ -6,7 +6,9 @@ slowest method instead of their sum (BENCHMARKS.md, "Figure 3 on Push"). Without
 at a time, and side by side takes as long as in turn.
 
 The parent starts one child per method (``python -m splid_jax.figures.side_by_side OUT METHOD``), each training
-its sweep as ``runs.train`` would, its output in OUT/logs/METHOD.log; only the parent writes OUT/figure.json. The
+its sweep as ``runs.train`` would, its output in OUT/logs/METHOD.log; only the parent writes OUT/figure.json.
+On a host of several GPUs the children are spread over them, one GPU each (CUDA_VISIBLE_DEVICES), and the
+heaviest methods are split by seed while GPUs are to spare (``spreading``); each sweep's record names its GPU. The
 children have sessions of their own, so a terminal's Ctrl-C reaches the parent alone, which passes each SIGINT or
 SIGTERM on once: every child checkpoints and stops, and ``--resume`` continues them. A child whose parent is gone
 stops so too.
@@ -23,6 +25,7 @@ import threading
 import time
 from typing import NamedTuple
 
+from splid_jax.figures import spreading
 from splid_jax.figures.record import SPEC, load_record, sweeps
 from splid_jax.figures.runs import train_sweep
 from splid_jax.runtime import checkpoint, loop, progress
@@ -65,10 +68,32 @@ def _compile_cache() -> str:
     return jax.config.jax_compilation_cache_dir or ""
 
 
-def child_command(out: str, method: str, resume: bool, compile_cache: str) -> list[str]:
-    return [sys.executable, "-m", __name__, out, method, "--compile-cache", compile_cache] + (
-        ["--resume"] if resume else []
+def child_command(out: str, method: str, resume: bool, compile_cache: str, part: str | None = None) -> list[str]:
+    return (
+        [sys.executable, "-m", __name__, out, method, "--compile-cache", compile_cache]
+        + (["--resume"] if resume else [])
+        + (["--part", part] if part else [])
     )
+
+
+def child_env(gpu: str | None) -> dict[str, str]:
+    """A child's environment: this process's, on the one GPU ``gpu`` when the figure is spread over several."""
+    return {**os.environ, **({"CUDA_VISIBLE_DEVICES": gpu} if gpu is not None else {})}
+
+
+def placed(record: dict, gpus: list[str]) -> tuple[dict, list[str | None]]:
+    """``record`` spread over ``gpus`` (split by seed where there are GPUs to spare, on a new figure), and
+    the GPU of each of its sweeps (all None on one GPU or none), noted in each sweep's record as "gpu"."""
+    if len(gpus) < 2:
+        return record, [None] * len(sweeps(record))
+    found = sweeps(record)
+    seeds = {m: 0 for m in record["methods"]}
+    for method, ran, _ in found:
+        seeds[method] += len(ran["members"])
+    where = spreading.assign([spreading.cost(m, len(ran["members"]), seeds[m]) for m, ran, _ in found], len(gpus))
+    for (_, ran, _), g in zip(found, where, strict=True):
+        ran["gpu"] = gpus[g]
+    return record, [gpus[g] for g in where]
 
 
 def _latest_iteration(out: str, sub: str, ran: dict) -> int | None:
@@ -85,17 +110,26 @@ def train_side_by_side(out: str, record: dict, quiet: bool, resume: bool = False
     cache), and notes each one's seconds in OUT/figure.json as it ends. Raises ``loop.Interrupted`` after
     passing a signal on (the children have checkpointed), ``loop.RunStopped`` naming the methods whose
     process failed and their logs."""
+    gpus = spreading.visible_gpus()
+    if not resume:  # a resumed figure keeps the parts it was started with
+        record.update(spreading.split(record, len(gpus)))
+    record, on = placed(record, gpus)
     loop.write_json(os.path.join(out, SPEC), record)  # what each child reads
     logs = os.path.join(out, LOGS)
     os.makedirs(logs, exist_ok=True)
     share_gpu_memory()  # the children inherit it
     jobs = []
-    for method, ran, sub in sweeps(record):
-        with open(os.path.join(logs, f"{method}.log"), "a") as log:  # the child holds its own copy of the file
-            cmd = child_command(out, method, resume, _compile_cache())
-            proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
-        jobs.append(Job(method, ran, sub, proc, time.perf_counter()))
-    progress.show(f"{record['figure']}: {len(jobs)} methods side by side, their output in {logs}", quiet)
+    for (method, ran, sub), gpu in zip(sweeps(record), on, strict=True):
+        name = sub.replace(os.sep, "-")
+        part = ran.get("dir")
+        with open(os.path.join(logs, f"{name}.log"), "a") as log:  # the child holds its own copy of the file
+            cmd = child_command(out, method, resume, _compile_cache(), part)
+            proc = subprocess.Popen(
+                cmd, stdout=log, stderr=subprocess.STDOUT, start_new_session=True, env=child_env(gpu)
+            )
+        jobs.append(Job(name, ran, sub, proc, time.perf_counter()))
+    spread = f" over GPUs {','.join(dict.fromkeys(g for g in on if g is not None))}" if len(gpus) > 1 else ""
+    progress.show(f"{record['figure']}: {len(jobs)} processes side by side{spread}, their output in {logs}", quiet)
     if not mps_running() and _on_gpu():
         print(
             "warning: no CUDA MPS daemon found (nvidia-cuda-mps-control -d): the GPU runs one process's kernels "
@@ -164,15 +198,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("method")
     parser.add_argument("--resume", action="store_true")
     parser.add_argument("--compile-cache", default="")
+    parser.add_argument("--part", default=None, help="one part (its directory) of a method split by seed")
     ns = parser.parse_args(argv)
     stop_when_orphaned(os.getppid())
     from splid_jax.cli import use_compile_cache
 
     use_compile_cache(ns.compile_cache)
     record = load_record(ns.out)
-    found = [(m, ran, sub) for m, ran, sub in sweeps(record) if m == ns.method]
+    found = [(m, ran, sub) for m, ran, sub in sweeps(record) if m == ns.method and ns.part in (None, ran.get("dir"))]
     if not found:
-        print(f"{parser.prog}: error: no method {ns.method!r} in {ns.out}", file=sys.stderr)
+        part = f" part {ns.part!r}" if ns.part else ""
+        print(f"{parser.prog}: error: no method {ns.method!r}{part} in {ns.out}", file=sys.stderr)
         return 2
     try:
         for method, ran, sub in found:

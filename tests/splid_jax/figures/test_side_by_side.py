@@ -13,7 +13,8 @@ import time
 
 import pytest
 
-from splid_jax.figures import side_by_side
+from splid_jax.figures import side_by_side, spreading
+from splid_jax.figures.record import sweeps
 from splid_jax.runtime import loop
 
 # a stand-in child: notes that it started, then exits with its method's code, or on SIGTERM notes the signal
@@ -25,23 +26,24 @@ def stop(signum, frame):
     sys.exit(128 + signum)
 signal.signal(signal.SIGTERM, stop)
 print("training", method, flush=True)
-open(os.path.join(out, method + ".started"), "w").close()
-code = {"ok": 0, "bad": 3}.get(method)
+open(os.path.join(out, method + ".started"), "w").write(os.environ.get("CUDA_VISIBLE_DEVICES", ""))
+code = 3 if method == "bad" else None if method.startswith("slow") else 0
 if code is None:
     time.sleep(60)
 sys.exit(code)
 """
 
 
-def record_of(methods):
-    runs = {m: {"config": {"iterations": 10}, "members": [{"run_dir": "s0"}]} for m in methods}
+def record_of(methods, seeds=1):
+    members = [{"run_dir": f"s{i}"} for i in range(seeds)]
+    runs = {m: {"config": {"iterations": 10}, "members": members} for m in methods}
     return {"figure": "fig3", "methods": list(methods), "runs": runs}
 
 
 @pytest.fixture
 def stand_in(monkeypatch):
-    def command(out, method, resume, cache):
-        return [sys.executable, "-c", CHILD, out, method]
+    def command(out, method, resume, cache, part=None):
+        return [sys.executable, "-c", CHILD, out, method + (f"-{part}" if part else "")]
 
     monkeypatch.setattr(side_by_side, "child_command", command)
 
@@ -117,3 +119,58 @@ def test_a_child_whose_parent_is_gone_stops_itself(tmp_path):
     while not marker.exists() and time.monotonic() < deadline:
         time.sleep(0.05)
     assert marker.read_text() == "15"
+
+
+FIG3 = ["splid", "gcsl", "pchid", "her", "es", "no-select"]
+
+
+def test_on_spare_gpus_the_heaviest_methods_are_split_by_seed_and_every_seed_kept():
+    record = record_of(FIG3, seeds=5)
+    assert spreading.split(record, 4) == record  # as many processes as GPUs or more: unchanged
+    split = spreading.split(record, 8)
+    subs = [sub for _, _, sub in sweeps(split)]
+    assert len(subs) == 8 and [s for s in subs if s.startswith("her/")] == [
+        "her/seeds-0-1",
+        "her/seeds-2-2",
+        "her/seeds-3-4",
+    ]  # HER, the heaviest by far, on three GPUs; the five lighter methods one each
+    for method in FIG3:
+        kept = [m["run_dir"] for x, ran, _ in sweeps(split) if x == method for m in ran["members"]]
+        assert kept == [f"s{i}" for i in range(5)]
+    assert spreading.split(record_of(["her"]), 8) == record_of(["her"])  # one seed: nothing to split
+
+
+def test_the_heaviest_process_goes_first_to_the_least_loaded_gpu():
+    costs = [spreading.cost(m, 5, 5) for m in FIG3]
+    where = spreading.assign(costs, 2)
+    assert where[FIG3.index("her")] == 0 and where[FIG3.index("splid")] == 1
+    loads = [sum(c for c, g in zip(costs, where, strict=True) if g == k) for k in (0, 1)]
+    assert max(loads) < sum(costs) * 0.6  # balanced, where all on one GPU would take the whole sum
+    assert sorted(spreading.assign(costs, 6)) == list(range(6))  # one process a GPU
+
+
+def test_children_are_spread_over_the_gpus_and_the_record_names_each_ones(tmp_path, stand_in, monkeypatch):
+    monkeypatch.setattr(spreading, "visible_gpus", lambda: ["3", "5"])
+    out = str(tmp_path)
+    side_by_side.train_side_by_side(out, record_of(["es", "her"], seeds=2), quiet=True, resume=False)
+    written = json.loads((tmp_path / "figure.json").read_text())
+    # three GPUs would split her; two hold the two methods, heaviest (her) first on the first
+    assert {m: ran["gpu"] for m, ran in written["runs"].items()} == {"her": "3", "es": "5"}
+    assert (tmp_path / "her.started").read_text() == "3" and (tmp_path / "es.started").read_text() == "5"
+
+
+def test_a_method_split_by_seed_runs_one_child_per_part(tmp_path, stand_in, monkeypatch):
+    monkeypatch.setattr(spreading, "visible_gpus", lambda: ["0", "1", "2"])
+    out = str(tmp_path)
+    side_by_side.train_side_by_side(out, record_of(["es", "her"], seeds=2), quiet=True, resume=False)
+    parts = json.loads((tmp_path / "figure.json").read_text())["runs"]["her"]["parts"]
+    assert [(p["dir"], p["gpu"]) for p in parts] == [("seeds-0-0", "0"), ("seeds-1-1", "1")]
+    assert (tmp_path / "her-seeds-1-1.started").read_text() == "1"
+    assert (tmp_path / "logs" / "her-seeds-0-0.log").exists()
+
+
+def test_a_child_asked_for_a_part_the_method_lacks_is_one_line(tmp_path, capsys):
+    split = spreading.split(record_of(["her"], seeds=2), 2)
+    (tmp_path / "figure.json").write_text(json.dumps(split))
+    assert side_by_side.main([str(tmp_path), "her", "--part", "seeds-0-1"]) == 2
+    assert capsys.readouterr().err.strip().endswith(f"no method 'her' part 'seeds-0-1' in {tmp_path}")
