@@ -43,7 +43,8 @@ without compilation, iterations and episodes each method ran) lie in OUT.
 A figure too long for one machine or call can be trained as --methods (fig3) or --values (fig4, fig5)
 subsets, each in its own --out, and joined with --merge (figN --merge DIR1 DIR2 ... --out OUT).
 fig3 --side-by-side trains its methods at once, one process each: on a GPU under CUDA MPS
-(nvidia-cuda-mps-control -d) they share it, where in turn their times add up.
+(nvidia-cuda-mps-control -d) they share it, where in turn their times add up; on several GPUs each
+process takes one, the heaviest first, and HER's and SPLID's seeds are split while GPUs are to spare.
 Exit codes: 0 done, 2 bad input (nothing trained), 3 a run stopped (NaN), 130 Ctrl-C, 143 SIGTERM
 (each method's newest state is kept; --resume continues)."""
 
@@ -115,7 +116,8 @@ def build_parser() -> Parser:
         "--side-by-side",
         action="store_true",
         help="fig3: train the methods at once, one process each, their output in OUT/logs/ (on a GPU, under "
-        "CUDA MPS: nvidia-cuda-mps-control -d; without it a GPU runs one process at a time, no faster than in turn)",
+        "CUDA MPS: nvidia-cuda-mps-control -d; without it a GPU runs one process at a time, no faster than in turn; "
+        "on several GPUs, one GPU per process, split by seed while GPUs are to spare)",
     )
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     add_compile_cache_flag(parser)
