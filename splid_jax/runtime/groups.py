@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import threading
+
 import jax
 import numpy as np
 
@@ -11,12 +13,12 @@ from splid_jax.runtime.signals import Signals
 
 class Groups:
     """A sweep's members in equal groups, one per device, each group a single-device program (the
-    vmapped chunk as one device runs it). Dispatch is asynchronous, so the devices run at once; a
-    group computes exactly what a sweep of its members computes on one device, and no collective
-    or SPMD partitioning is involved (XLA:CPU can hang in multi-device programs). The devices' programs
-    compile at once, each in a thread. Over several
-    processes each runs the groups of its own devices, and the members' metrics and checkpointed
-    state are gathered between chunks (``multihost.concat``)."""
+    vmapped chunk as one device runs it). Each device's program is called from a thread of its own, so
+    the devices run at once; a group computes exactly what a sweep of its members computes on one
+    device, and no collective or SPMD partitioning is involved (XLA:CPU can hang in multi-device
+    programs). The devices' programs compile at once, each in a thread. Over several processes each
+    runs the groups of its own devices, and the members' metrics and checkpointed state are gathered
+    between chunks (``multihost.concat``)."""
 
     def __init__(self, place: devices.Placement, members: int):
         every = list(place.mesh.devices.flat)
@@ -51,10 +53,35 @@ class Groups:
         programs = [first, *(signals.wait(p) for p in pending)]
 
         def run(states: tuple, hypers: tuple):
-            outs = [p(s, h) for p, s, h in zip(programs, states, hypers, strict=True)]  # dispatched at once
+            outs = _at_once([lambda p=p, s=s, h=h: p(s, h) for p, s, h in zip(programs, states, hypers, strict=True)])
             return tuple(o[0] for o in outs), multihost.concat(_concat([o[1] for o in outs]))
 
         return run
+
+
+def _at_once(calls: list) -> list:
+    """Each call in a thread of its own, their results in order (the first error raised): a GPU program can
+    hold its caller's thread while it runs (XLA:GPU reads a loop's condition back to the host), so calls
+    made in turn from one thread could run the devices one after another."""
+    if len(calls) == 1:
+        return [calls[0]()]
+    box: list = [None] * len(calls)
+
+    def call(i):
+        try:
+            box[i] = (True, calls[i]())
+        except BaseException as e:  # re-raised in the caller's thread
+            box[i] = (False, e)
+
+    threads = [threading.Thread(target=call, args=(i,), daemon=True) for i in range(len(calls))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for ok, value in box:
+        if not ok:
+            raise value
+    return [value for _, value in box]
 
 
 def _concat(groups):
