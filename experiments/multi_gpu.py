@@ -1,14 +1,25 @@
 """One GPU against N of the same host, in one call: a sweep, Figure 3 side by side, a single large run, and two
 processes under jax.distributed (issues "Every GPU of a host" and "Figure 3 on 4 and 8 GPUs").
 
-    python experiments/multi_gpu.py OUT --gpus 2 [--parts sweep,figure,single] [--budget-s 510]
+    python experiments/multi_gpu.py OUT --gpus N [--parts sweep,single,figure,processes] [--budget-s 510]
 
-Each part runs its 1-GPU side, then its N-GPU side, one after the other (CUDA_VISIBLE_DEVICES), with the compile
-cache off on both. Runs write under a scratch directory that is removed; OUT gets results.json (every number),
-summary.txt (the table) and logs.txt (each command and the tail of its output). A part that would not end within
---budget-s of the script's start, at its estimate, is skipped and said so; every command also stops at what is
-left of the budget. On a CPU host the "GPUs" are host devices (XLA_FLAGS=--xla_force_host_platform_device_count=N):
-give small sizes (--sweep-env point --single-env point ...) to try the script itself.
+- sweep: an 8-seed Push sweep of 10 iterations (--sweep-*), --num-devices 1 against N: episodes per second over the
+  chunks after the first (from the members' metrics, whose clock starts after the compile), compile and wall seconds;
+- single: one PickAndPlace SPLID run at 4,096 envs for 4 iterations (--single-*), its envs split over 1 against N
+  GPUs: seconds per iteration after the first chunk, compile and wall seconds, or the error that stopped it;
+- figure: Figure 3 on Push at 1,000 episodes a method (--figure-episodes), --side-by-side on 1 GPU against N (under
+  CUDA MPS, started here if no daemon runs and stopped after): the whole command's seconds and each process's;
+- processes (not by default): a 2-seed sweep as two processes of one GPU each under jax.distributed.
+
+Each part runs its 1-GPU side, then its N-GPU side (CUDA_VISIBLE_DEVICES), or both at once with --concurrent (the
+1-GPU side on GPU N, so N + 1 GPUs), the compile cache off on both. Expected on H100s, in turn: sweep about 2.5 min,
+single about 3.5 min, figure about 4 min at 1,000 episodes (Figure 3 at 20,000 episodes takes about 7 min on one
+GPU alone: a call of its own, --parts figure --figure-episodes 20000, on a host where --concurrent applies). A part
+whose estimate exceeds what is left of --budget-s is skipped and said so, and every command stops at the budget, so
+the script ends within it. Runs write under a scratch directory that is removed; OUT gets results.json (every
+number), summary.txt (the table) and logs.txt (each command and the tail of its output). On a CPU host the "GPUs"
+are host devices (XLA_FLAGS=--xla_force_host_platform_device_count=N): small sizes (--sweep-env point --single-env
+point ...) try the script itself.
 """
 
 from __future__ import annotations
@@ -22,6 +33,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -33,10 +45,11 @@ def say(text: str) -> None:
     print(f"[{time.monotonic() - T0:6.0f} s] {text}", flush=True)
 
 
-def env_for(gpus: int) -> dict:
-    """This process's environment on the first ``gpus`` GPUs, NVLink multicast off, the repository first on the path."""
+def env_for(gpus: int, first: int = 0) -> dict:
+    """This process's environment on ``gpus`` GPUs from GPU ``first`` on, NVLink multicast off, the repository
+    first on the path."""
     env = dict(os.environ)
-    env["CUDA_VISIBLE_DEVICES"] = ",".join(str(i) for i in range(gpus))
+    env["CUDA_VISIBLE_DEVICES"] = ",".join(str(first + i) for i in range(gpus))
     env["NCCL_NVLS_ENABLE"] = "0"
     env["PYTHONPATH"] = os.pathsep.join([ROOT, *filter(None, [os.environ.get("PYTHONPATH")])])
     return env
@@ -49,6 +62,24 @@ class Runner:
 
     def left(self) -> float:
         return self.budget_s - (time.monotonic() - T0)
+
+    def sides(self, name: str, build, a: argparse.Namespace) -> dict:
+        """``build(gpus)``'s command on 1 GPU and on N, one after the other, or with ``--concurrent`` at once, the
+        1-GPU side on GPU N (the N+1-th); the results by side ("1", "N")."""
+        first = {1: a.gpus if a.concurrent else 0, a.gpus: 0}
+        todo = {g: (f"{name} on {g} GPU(s)", build(g), env_for(g, first[g])) for g in (1, a.gpus)}
+        if not a.concurrent:
+            return {str(g): self.run(*job) for g, job in todo.items()}
+        got: dict = {}
+        threads = [
+            threading.Thread(target=lambda g=g, job=job: got.update({str(g): self.run(*job)}))
+            for g, job in todo.items()
+        ]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        return got
 
     def run(self, name: str, cmd: list[str], env: dict) -> dict:
         """``cmd``'s exit code, wall seconds and output, stopped at what is left of the budget."""
@@ -98,21 +129,20 @@ def rate(runs: list[list[dict]]) -> dict:
 
 
 def sweep(r: Runner, a: argparse.Namespace, scratch: str) -> dict:
+    def build(gpus):
+        return [sys.executable, "-m", "splid_jax.sweep", "--env", a.sweep_env, "--seeds", str(a.sweep_seeds),
+                "--iterations", str(a.sweep_iterations), "--eval-every", str(a.sweep_eval_every), "--num-devices",
+                str(gpus), "--checkpoint-every", "0", "--compile-cache", "", "--no-plot", "--run-dir",
+                os.path.join(scratch, f"sweep-{gpus}"), *a.sweep_args.split()]  # fmt: skip
+
     out = {}
-    for gpus in (1, a.gpus):
-        run_dir = os.path.join(scratch, f"sweep-{gpus}")
-        cmd = [sys.executable, "-m", "splid_jax.sweep", "--env", a.sweep_env, "--seeds", str(a.sweep_seeds),
-               "--iterations", str(a.sweep_iterations), "--eval-every", str(a.sweep_eval_every), "--num-devices",
-               str(gpus), "--checkpoint-every", "0", "--compile-cache", "", "--no-plot", "--run-dir", run_dir,
-               *a.sweep_args.split()]  # fmt: skip
-        done = r.run(f"sweep on {gpus} GPU(s)", cmd, env_for(gpus))
+    for side, done in r.sides("sweep", build, a).items():
+        run_dir = os.path.join(scratch, f"sweep-{side}")
         runs = [metrics(p) for p in sorted(glob.glob(os.path.join(run_dir, "*", "metrics.jsonl")))]
-        placed = [
-            json.load(open(p)).get("devices")
-            for p in sorted(glob.glob(os.path.join(run_dir, "*", "config.json")))[:: max(a.sweep_seeds // 2, 1)]
-        ]
-        out[str(gpus)] = {"rc": done["rc"], "wall_s": done["wall_s"], "compile_s": compile_s(done["output"]),
-                          **rate(runs), "devices_of_two_members": placed}  # fmt: skip
+        configs = sorted(glob.glob(os.path.join(run_dir, "*", "config.json")))
+        placed = [json.load(open(p)).get("devices") for p in configs[:: max(len(configs) - 1, 1)]]
+        out[side] = {"rc": done["rc"], "wall_s": done["wall_s"], "compile_s": compile_s(done["output"]),
+                     **rate(runs), "devices_of_first_and_last_member": placed}  # fmt: skip
         shutil.rmtree(run_dir, ignore_errors=True)
     one, many = out.get("1", {}), out.get(str(a.gpus), {})
     if one.get("episodes_per_s") and many.get("episodes_per_s"):
@@ -131,12 +161,14 @@ def figure(r: Runner, a: argparse.Namespace, scratch: str) -> dict:
         time.sleep(1)
     out["mps"] = bool(mps)
     try:
-        for gpus in (1, a.gpus):
-            fig = os.path.join(scratch, f"fig3-{gpus}")
-            cmd = [sys.executable, "-m", "splid_jax.figures", "fig3", "--env", a.figure_env, "--episodes",
-                   str(a.figure_episodes), "--side-by-side", "--set", "checkpoint_every=0", "--compile-cache", "",
-                   "--out", fig, "--quiet", *a.figure_args.split()]  # fmt: skip
-            done = r.run(f"figure 3 on {gpus} GPU(s)", cmd, env_for(gpus))
+
+        def build(gpus):
+            return [sys.executable, "-m", "splid_jax.figures", "fig3", "--env", a.figure_env, "--episodes",
+                    str(a.figure_episodes), "--side-by-side", "--set", "checkpoint_every=0", "--compile-cache", "",
+                    "--out", os.path.join(scratch, f"fig3-{gpus}"), "--quiet", *a.figure_args.split()]  # fmt: skip
+
+        for side, done in r.sides("figure 3", build, a).items():
+            fig = os.path.join(scratch, f"fig3-{side}")
             try:
                 record = json.load(open(os.path.join(fig, "figure.json")))
                 per = {
@@ -146,7 +178,7 @@ def figure(r: Runner, a: argparse.Namespace, scratch: str) -> dict:
                 }
             except (OSError, json.JSONDecodeError, KeyError):
                 per = {}
-            out[str(gpus)] = {"rc": done["rc"], "wall_s": done["wall_s"], "processes": per}
+            out[side] = {"rc": done["rc"], "wall_s": done["wall_s"], "processes": per}
             shutil.rmtree(fig, ignore_errors=True)
     finally:
         if started:
@@ -159,17 +191,19 @@ def figure(r: Runner, a: argparse.Namespace, scratch: str) -> dict:
 
 def single(r: Runner, a: argparse.Namespace, scratch: str) -> dict:
     out = {"env": a.single_env, "num_envs": a.single_envs}
-    for gpus in (1, a.gpus):
-        run_dir = os.path.join(scratch, f"single-{gpus}")
-        cmd = [sys.executable, "-m", "splid_jax.train", "--env", a.single_env, "--num-envs", str(a.single_envs),
-               "--iterations", str(a.single_iterations), "--eval-every", str(a.single_eval_every), "--num-devices",
-               str(gpus), "--checkpoint-every", "0", "--compile-cache", "", "--run-dir", run_dir,
-               *a.single_args.split()]  # fmt: skip
-        done = r.run(f"single {a.single_env} run on {gpus} GPU(s)", cmd, env_for(gpus))
+
+    def build(gpus):
+        return [sys.executable, "-m", "splid_jax.train", "--env", a.single_env, "--num-envs", str(a.single_envs),
+                "--iterations", str(a.single_iterations), "--eval-every", str(a.single_eval_every), "--num-devices",
+                str(gpus), "--checkpoint-every", "0", "--compile-cache", "", "--run-dir",
+                os.path.join(scratch, f"single-{gpus}"), *a.single_args.split()]  # fmt: skip
+
+    for side, done in r.sides(f"single {a.single_env} run", build, a).items():
+        run_dir = os.path.join(scratch, f"single-{side}")
         got = rate([metrics(os.path.join(run_dir, "metrics.jsonl"))])
         error = [line for line in done["output"].splitlines() if "error" in line.lower()][-1:]
-        out[str(gpus)] = {"rc": done["rc"], "wall_s": done["wall_s"], "compile_s": compile_s(done["output"]), **got,
-                          **({"error": error[0][-300:]} if done["rc"] != 0 and error else {})}  # fmt: skip
+        out[side] = {"rc": done["rc"], "wall_s": done["wall_s"], "compile_s": compile_s(done["output"]), **got,
+                     **({"error": error[0][-300:]} if done["rc"] != 0 and error else {})}  # fmt: skip
         shutil.rmtree(run_dir, ignore_errors=True)
     one, many = out.get("1", {}), out.get(str(a.gpus), {})
     if one.get("s_per_iteration") and many.get("s_per_iteration"):
@@ -214,42 +248,51 @@ def processes(r: Runner, a: argparse.Namespace, scratch: str) -> dict:
 
 
 def estimate(part: str, a: argparse.Namespace) -> float:
-    """Seconds a part is expected to take on H100s, both sides: compiles at about a minute and a half each (the
-    figure's six at once), and the training at the sizes asked."""
+    """Seconds a part is expected to take on H100s (the process's start, tracing and compiling at a minute to a
+    minute and a half a side, then the training at the sizes asked), both sides in turn, or the longer of them
+    with --concurrent. A guess from one-GPU runs, to skip a part that cannot end in time."""
     if part == "sweep":
-        return 2 * (90 + a.sweep_iterations * 1.0)
-    if part == "figure":
-        return 2 * 100 + (a.figure_episodes / 16) * 0.6 * 1.3  # HER's cycles, shared on one GPU, then spread
-    if part == "single":
-        return 2 * (100 + a.single_iterations * 6.0)
-    return 120 + a.sweep_eval_every * 2 * 1.0
+        sides = [60 + a.sweep_iterations * 0.8] * 2
+    elif part == "figure":  # HER's cycles of 16 episodes: about 0.56 s shared with five methods, 0.12 s alone
+        sides = [90 + a.figure_episodes / 16 * 0.56, 90 + a.figure_episodes / 16 * 0.2]
+    elif part == "single":
+        sides = [75 + a.single_iterations * 6.0] * 2
+    else:
+        return 120 + a.sweep_eval_every * 2 * 1.0
+    return max(sides) if a.concurrent else sum(sides)
 
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("out", help="directory for results.json, summary.txt and logs.txt")
     p.add_argument("--gpus", type=int, required=True, help="N: the GPUs of the N-GPU side (the first N)")
-    p.add_argument("--parts", default="sweep,figure,single", help="comma-separated, of " + ", ".join(PARTS))
+    p.add_argument("--parts", default="sweep,single,figure", help="comma-separated, of " + ", ".join(PARTS))
     p.add_argument("--budget-s", type=float, default=510.0, help="seconds for the whole script (default 510)")
     p.add_argument("--sweep-env", default="push")
     p.add_argument("--sweep-seeds", type=int, default=8)
-    p.add_argument("--sweep-iterations", type=int, default=20)
+    p.add_argument("--sweep-iterations", type=int, default=10)
     p.add_argument("--sweep-eval-every", type=int, default=5)
     p.add_argument("--sweep-args", default="", help="more sweep flags, space-separated")
     p.add_argument("--figure-env", default="push")
-    p.add_argument("--figure-episodes", type=int, default=2000, help="Figure 3's budget per method (default 2,000)")
+    p.add_argument("--figure-episodes", type=int, default=1000, help="Figure 3's budget per method (default 1,000)")
     p.add_argument("--figure-args", default="", help="more figures flags, space-separated (e.g. --quick --seeds 2)")
     p.add_argument("--single-env", default="pick_and_place")
     p.add_argument("--single-envs", type=int, default=4096)
     p.add_argument("--single-iterations", type=int, default=4)
     p.add_argument("--single-eval-every", type=int, default=2)
     p.add_argument("--single-args", default="", help="more train flags, space-separated")
+    p.add_argument(
+        "--concurrent",
+        action="store_true",
+        help="each part's two sides at once, the 1-GPU side on GPU N "
+        "(needs N + 1 GPUs); without it one after the other",
+    )
     p.add_argument("--scratch", default=None, help="where runs are written, then removed (default: a new temp dir)")
     a = p.parse_args(argv)
     parts = [x for x in a.parts.split(",") if x]
     unknown = [x for x in parts if x not in PARTS]
-    if unknown or a.gpus < 1:
-        p.error(f"unknown part(s) {unknown}" if unknown else "--gpus must be >= 1")
+    if unknown or a.gpus < 2:
+        p.error(f"unknown part(s) {unknown}" if unknown else "--gpus must be >= 2")
     os.makedirs(a.out, exist_ok=True)
     scratch = tempfile.mkdtemp(prefix="multi-gpu-", dir=a.scratch)
     r = Runner(a.out, a.budget_s)
@@ -263,7 +306,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         for part in parts:
             need = estimate(part, a)
-            if need > r.left():
+            if need > 1.25 * r.left():  # every command also stops at the budget
                 results[part] = {"skipped": f"estimated {need:.0f} s, {r.left():.0f} s left of the budget"}
                 say(f"{part}: skipped ({results[part]['skipped']})")
                 continue
