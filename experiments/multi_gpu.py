@@ -9,7 +9,8 @@ processes under jax.distributed (issues "Every GPU of a host" and "Figure 3 on 4
   GPUs: seconds per iteration after the first chunk, compile and wall seconds, or the error that stopped it;
 - figure: Figure 3 on Push at 1,000 episodes a method (--figure-episodes), --side-by-side on 1 GPU against N (under
   CUDA MPS, started here if no daemon runs and stopped after): the whole command's seconds and each process's;
-- processes (not by default): a 2-seed sweep as two processes of one GPU each under jax.distributed.
+- processes: a 2-seed sweep as two processes of one GPU each under jax.distributed (last, so run only where time
+  is left: --parts processes alone takes about 2 min).
 
 Each part runs its 1-GPU side, then its N-GPU side (CUDA_VISIBLE_DEVICES), or both at once with --concurrent (the
 1-GPU side on GPU N, so N + 1 GPUs), the compile cache off on both. Expected on H100s, in turn: sweep about 2.5 min,
@@ -266,7 +267,7 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("out", help="directory for results.json, summary.txt and logs.txt")
     p.add_argument("--gpus", type=int, required=True, help="N: the GPUs of the N-GPU side (the first N)")
-    p.add_argument("--parts", default="sweep,single,figure", help="comma-separated, of " + ", ".join(PARTS))
+    p.add_argument("--parts", default="sweep,single,figure,processes", help="comma-separated, of " + ", ".join(PARTS))
     p.add_argument("--budget-s", type=float, default=510.0, help="seconds for the whole script (default 510)")
     p.add_argument("--sweep-env", default="push")
     p.add_argument("--sweep-seeds", type=int, default=8)
