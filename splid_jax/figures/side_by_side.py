@@ -82,11 +82,13 @@ def child_env(gpu: str | None) -> dict[str, str]:
 
 
 def placed(record: dict, gpus: list[str]) -> tuple[dict, list[str | None]]:
-    """``record`` spread over ``gpus`` (split by seed where there are GPUs to spare, on a new figure), and
-    the GPU of each of its sweeps (all None on one GPU or none), noted in each sweep's record as "gpu"."""
-    if len(gpus) < 2:
-        return record, [None] * len(sweeps(record))
+    """``record`` with each of its sweeps placed on one of ``gpus`` (noted in the sweep's record as "gpu"),
+    and each one's GPU: all None on one GPU or none, where the children share what this process sees."""
     found = sweeps(record)
+    if len(gpus) < 2:
+        for _, ran, _ in found:
+            ran.pop("gpu", None)  # placed when started on several, not now
+        return record, [None] * len(found)
     seeds = {m: 0 for m in record["methods"]}
     for method, ran, _ in found:
         seeds[method] += len(ran["members"])
