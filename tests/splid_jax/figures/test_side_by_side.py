@@ -14,7 +14,6 @@ import time
 import pytest
 
 from splid_jax.figures import side_by_side, spreading
-from splid_jax.figures.record import sweeps
 from splid_jax.runtime import loop
 
 # a stand-in child: notes that it started, then exits with its method's code, or on SIGTERM notes the signal
@@ -119,34 +118,6 @@ def test_a_child_whose_parent_is_gone_stops_itself(tmp_path):
     while not marker.exists() and time.monotonic() < deadline:
         time.sleep(0.05)
     assert marker.read_text() == "15"
-
-
-FIG3 = ["splid", "gcsl", "pchid", "her", "es", "no-select"]
-
-
-def test_on_spare_gpus_the_heaviest_methods_are_split_by_seed_and_every_seed_kept():
-    record = record_of(FIG3, seeds=5)
-    assert spreading.split(record, 4) == record  # as many processes as GPUs or more: unchanged
-    split = spreading.split(record, 8)
-    subs = [sub for _, _, sub in sweeps(split)]
-    assert len(subs) == 8 and [s for s in subs if s.startswith("her/")] == [
-        "her/seeds-0-1",
-        "her/seeds-2-2",
-        "her/seeds-3-4",
-    ]  # HER, the heaviest by far, on three GPUs; the five lighter methods one each
-    for method in FIG3:
-        kept = [m["run_dir"] for x, ran, _ in sweeps(split) if x == method for m in ran["members"]]
-        assert kept == [f"s{i}" for i in range(5)]
-    assert spreading.split(record_of(["her"]), 8) == record_of(["her"])  # one seed: nothing to split
-
-
-def test_the_heaviest_process_goes_first_to_the_least_loaded_gpu():
-    costs = [spreading.cost(m, 5, 5) for m in FIG3]
-    where = spreading.assign(costs, 2)
-    assert where[FIG3.index("her")] == 0 and where[FIG3.index("splid")] == 1
-    loads = [sum(c for c, g in zip(costs, where, strict=True) if g == k) for k in (0, 1)]
-    assert max(loads) < sum(costs) * 0.6  # balanced, where all on one GPU would take the whole sum
-    assert sorted(spreading.assign(costs, 6)) == list(range(6))  # one process a GPU
 
 
 def test_children_are_spread_over_the_gpus_and_the_record_names_each_ones(tmp_path, stand_in, monkeypatch):
