@@ -172,11 +172,15 @@ def figure(r: Runner, a: argparse.Namespace, scratch: str) -> dict:
             fig = os.path.join(scratch, f"fig3-{side}")
             try:
                 record = json.load(open(os.path.join(fig, "figure.json")))
-                per = {
-                    f"{m}/{ran['dir']}" if "dir" in ran else m: {"total_s": ran.get("total_s"), "gpu": ran.get("gpu")}
-                    for m, top in record["runs"].items()
-                    for ran in top.get("parts", [top])
-                }
+                per = {}
+                for m, top in record["runs"].items():
+                    for ran in top.get("parts", [top]):
+                        name = f"{m}-{ran['dir']}" if "dir" in ran else m
+                        try:
+                            compiled = compile_s(open(os.path.join(fig, "logs", f"{name}.log")).read())
+                        except OSError:
+                            compiled = None
+                        per[name] = {"total_s": ran.get("total_s"), "compile_s": compiled, "gpu": ran.get("gpu")}
             except (OSError, json.JSONDecodeError, KeyError):
                 per = {}
             out[side] = {"rc": done["rc"], "wall_s": done["wall_s"], "processes": per}
@@ -302,6 +306,10 @@ def main(argv: list[str] | None = None) -> int:
     probe = "import jax; print(jax.__version__, [f'{d.platform}:{d.id} {d.device_kind}' for d in jax.devices()])"
     seen = subprocess.run([sys.executable, "-c", probe], env=env_for(a.gpus), capture_output=True, text=True)
     results["devices"] = seen.stdout.strip() or seen.stderr.strip()[-300:]
+    results["cpus"] = os.cpu_count()
+    if shutil.which("nvidia-smi"):  # how the GPUs are linked, for where scaling falls short
+        topo = subprocess.run(["nvidia-smi", "topo", "-m"], capture_output=True, text=True)
+        results["topology"] = topo.stdout.strip().splitlines()[: 2 + a.gpus]
     say(f"devices: {results['devices']}; parts {parts}; budget {a.budget_s:.0f} s")
     done_fns = {"sweep": sweep, "figure": figure, "single": single, "processes": processes}
     try:
