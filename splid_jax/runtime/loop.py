@@ -210,7 +210,7 @@ class _Loop:
                 lambda: [(read_metrics(os.path.join(m.run_dir, METRICS)) or [{}])[-1] for m in self.lanes]
             )
         if resume and step is None:
-            self.show(f"{cfg.run_dir}: stopped before its first checkpoint; starting it again")
+            self.show(f"{cfg.run_dir}: stopped before its first checkpoint; starting it again, its records dropped")
             resume = False
         multihost.from_first(lambda: check_writable(cfg.run_dir))
         self.saved_at = step

@@ -89,28 +89,34 @@ def recorded(run_dir: str) -> str | None:
     return None
 
 
+def holds_run(run_dir: str) -> bool:
+    """Whether ``run_dir`` holds a run that ``--resume`` continues: a checkpoint, or the config.json or
+    sweep.json written before its first chunk (then it starts again)."""
+    if not os.path.isdir(run_dir):
+        return False
+    if any(os.path.isfile(os.path.join(run_dir, f)) for f in ("config.json", SWEEP)):
+        return True
+    return checkpoint.latest_step(run_dir) is not None
+
+
 def check_run_dir(cfg: TrainConfig, resume: bool) -> int | None:
     """Refuses a run that would overwrite another, or a resume to fewer iterations than done;
-    returns the step a resume starts from, None where the run stopped before its first checkpoint
-    and recorded nothing (it then starts again)."""
+    returns the step a resume starts from, None where the run stopped before its first whole
+    checkpoint (it then starts again, its records dropped)."""
     if not resume:
+        hint = f"; to continue that run: --resume {cfg.run_dir}"
         if os.path.isdir(cfg.run_dir) and checkpoint.latest_step(cfg.run_dir) is not None:
-            raise InvalidConfig("run_dir", cfg.run_dir, "a directory without a run in it (or pass --resume RUN_DIR)")
+            why = f"a directory without a run in it (it holds a checkpoint{hint})"
+            raise InvalidConfig("run_dir", cfg.run_dir, why)
         held = holds_metrics(cfg.run_dir)
         if held is not None:
-            raise InvalidConfig("run_dir", cfg.run_dir, f"a directory without a run in it (it holds {held})")
+            hint = hint if holds_run(cfg.run_dir) else ""
+            raise InvalidConfig("run_dir", cfg.run_dir, f"a directory without a run in it (it holds {held}{hint})")
         return None
-    step = checkpoint.latest_step(cfg.run_dir) if os.path.isdir(cfg.run_dir) else None
-    if step is None and not os.path.isfile(os.path.join(cfg.run_dir, "config.json")) and not os.path.isfile(
-        os.path.join(cfg.run_dir, SWEEP)
-    ):
-        raise InvalidConfig("resume", cfg.run_dir, "a run directory holding a checkpoint")
-    if step is None:  # stopped before its first save (killed, or a save not waited for): nothing to keep
-        held = recorded(cfg.run_dir)
-        if held is not None:
-            raise InvalidConfig("resume", cfg.run_dir, f"a run directory holding a checkpoint (it holds {held})")
-        return None
-    if step > cfg.iterations:
+    if not holds_run(cfg.run_dir):
+        raise InvalidConfig("resume", cfg.run_dir, "a run directory holding a checkpoint or its config.json")
+    step = checkpoint.latest_step(cfg.run_dir)
+    if step is not None and step > cfg.iterations:
         raise InvalidConfig("iterations", cfg.iterations, f">= {step}, the iterations {cfg.run_dir} has completed")
     return step
 

@@ -1,0 +1,84 @@
+"""A run directory is always continued from its last whole checkpoint, or started again where it has
+none: a real process killed after its first metrics line and before its first checkpoint, for a run,
+a sweep and a figure."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+
+import pytest
+
+from splid_jax import figures, sweep, train
+from splid_jax.runtime import checkpoint
+
+# Every checkpoint save blocks: the process is killed in the gap between a chunk's metrics line and its
+# checkpoint, which a real run opens for the save's length.
+SAVES_NEVER_END = """
+import runpy, sys, threading
+from splid_jax.runtime import checkpoint
+def save(run_dir, step, *a, **kw):
+    print("saving", step, flush=True)
+    threading.Event().wait()
+checkpoint.save = save
+module = sys.argv.pop(1)
+runpy.run_module(module, run_name="__main__", alter_sys=True)
+"""
+
+SMALL = ["--num-envs", "4", "--eval-episodes", "8", "--eval-every", "5", "--bc-steps", "5", "--batch-size", "16",
+         "--hidden", "16", "--iterations", "10"]  # fmt: skip
+QUICK = ["--quick", "--seeds", "1", "--episodes", "80", "--set", "eval_episodes=8", "--set", "hidden=16"]
+COMMANDS = {  # the first command, and the one that continues it, given the directory
+    "train": (train, lambda d: ["--env", "point", *SMALL, "--run-dir", d], lambda d: ["--resume", d]),
+    "sweep": (
+        sweep,
+        lambda d: ["--env", "point", *SMALL, "--seeds", "2", "--no-plot", "--run-dir", d],
+        lambda d: ["--resume", d, "--no-plot"],
+    ),
+    "figures": (figures, lambda d: ["fig8", *QUICK, "--out", d], lambda d: ["fig8", "--out", d, "--resume"]),
+}
+
+
+def killed_in_the_gap(module: str, args: list[str]) -> None:
+    proc = subprocess.Popen([sys.executable, "-c", SAVES_NEVER_END, module, *args, "--quiet"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        for line in proc.stdout:
+            if line.startswith("saving"):
+                break
+        else:
+            raise AssertionError(f"the run ended before its first save: {proc.stderr.read()}")
+    finally:
+        proc.send_signal(signal.SIGKILL)
+        proc.communicate(timeout=60)
+
+
+def metrics_files(root: str) -> list[str]:
+    return sorted(os.path.join(d, f) for d, _, files in os.walk(root) for f in files if f == "metrics.jsonl")
+
+
+def iterations(path: str) -> list[int]:
+    with open(path) as fh:
+        return [json.loads(line)["iteration"] for line in fh]
+
+
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_a_run_killed_before_its_first_checkpoint_starts_again_on_resume(tmp_path, capsys, command):
+    module, first, again = COMMANDS[command]
+    run_dir = str(tmp_path / "run")
+    killed_in_the_gap(module.__name__, first(run_dir))
+    recorded = metrics_files(run_dir)
+    assert recorded and any(iterations(p) for p in recorded)  # the gap: records, and no checkpoint
+    assert all(checkpoint.latest_step(os.path.dirname(p)) is None for p in recorded + [os.path.join(run_dir, "x")])
+    if command != "figures":  # the first command again says how to go on, and changes nothing
+        before = {p: open(p).read() for p in recorded}
+        assert module.main([*first(run_dir), "--quiet"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and f"--resume {run_dir}" in err
+        assert {p: open(p).read() for p in recorded} == before
+    assert module.main([*again(run_dir), "--quiet"]) == 0
+    for path in metrics_files(run_dir):  # each record once, up to the checkpoint the run ends on
+        done = iterations(path)
+        assert done and done == list(range(5, done[-1] + 1, 5)), path
+        assert checkpoint.latest_step(os.path.dirname(os.path.dirname(path))) in (done[-1], None)
