@@ -272,7 +272,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as e:
         print(f"plot: cannot write {out}: {e.strerror or e}", file=sys.stderr)
         return 2
-    print(out)
+    progress.show(out)
     return 0
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import sys
@@ -56,8 +57,22 @@ def sweep_line(recs: list[dict], total_iterations: int) -> str:
 
 
 def show(text: str, quiet: bool = False) -> None:
-    if not quiet:
+    """``text`` on stdout; once stdout is closed (``| head``) the display goes quiet and the work goes on."""
+    if quiet:
+        return
+    try:
         print(text, file=sys.stdout, flush=True)
+    except BrokenPipeError:
+        quiet_stdout()
+
+
+def quiet_stdout() -> None:
+    """stdout's descriptor pointed at /dev/null: what is still buffered, and any later print, goes
+    nowhere instead of raising again (at exit too)."""
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
 
 
 def read_metrics(path: str, error: type[Exception]) -> list[dict]:
