@@ -169,10 +169,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (loop.RunStopped, checkpoint.CheckpointError) as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 3
-    except OSError as err:  # a file of the figure's own (figure.json, the PNG) on a full disk
-        if not checkpoint.is_no_space(err):
+    except OSError as err:  # a file of the figure's own (figure.json, the PNG) on a full or read-only disk
+        failure = checkpoint.write_failure(err)
+        if failure is None:
             raise
-        print(f"{parser.prog}: error: no space left on the device ({err.filename or out})", file=sys.stderr)
+        why = "no space left on the device" if checkpoint.is_no_space(err) else f"cannot write {out}: {failure[1]}"
+        print(f"{parser.prog}: error: {why} ({err.filename or out})", file=sys.stderr)
         return 3
     progress.show(f"figure: {png}\ntable: {table}", ns.quiet)
     return 0
