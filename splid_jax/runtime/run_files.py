@@ -3,7 +3,6 @@ the checks that keep one run from overwriting another."""
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import json
 import os
@@ -11,7 +10,7 @@ import sys
 
 import envs
 from splid_jax.common.errors import InvalidConfig
-from splid_jax.common.paths import missing_parents
+from splid_jax.common.paths import unwritable
 from splid_jax.config import TrainConfig
 from splid_jax.runtime import checkpoint, progress
 
@@ -122,19 +121,7 @@ def check_run_dir(cfg: TrainConfig, resume: bool) -> int | None:
 
 
 def check_writable(run_dir: str) -> None:
-    """Creates ``run_dir`` and a file in it, then removes what it made: a read-only filesystem or
-    /proc fails here, naming the directory, before any work."""
-    made = missing_parents(run_dir)
-    try:
-        for d in reversed(made):
-            os.mkdir(d)
-        probe = os.path.join(run_dir, f".write-test-{os.getpid()}")
-        with open(probe, "w") as fh:
-            fh.write("x")
-        os.remove(probe)
-    except OSError as e:
-        raise InvalidConfig("run_dir", run_dir, f"a writable directory ({e.strerror})") from None
-    finally:
-        for d in made:
-            with contextlib.suppress(OSError):
-                os.rmdir(d)
+    """A read-only filesystem or /proc fails here, naming the directory, before any work."""
+    why = unwritable(run_dir)
+    if why:
+        raise InvalidConfig("run_dir", run_dir, f"a writable directory ({why})")
