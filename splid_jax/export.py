@@ -11,9 +11,11 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import errno
 import os
 import shutil
 import sys
+import tempfile
 from collections.abc import Sequence
 
 from splid_jax.cli import Parser, exit_with, quiet_interrupts
@@ -50,14 +52,33 @@ def export(run_dir: str, out: str, step: int | None = None) -> dict:
     like = make_algorithm(small, env).init(jax.random.PRNGKey(0))
     exported = like.replace(policy=state.policy)
     record = {"run_dir": os.path.abspath(run_dir), "step": int(step), "config": cfg.to_json()}
-    os.makedirs(out)
-    write_json(os.path.join(out, "config.json"), small.to_json())
-    metrics = os.path.join(run_dir, METRICS)
-    if os.path.isfile(metrics):
-        shutil.copyfile(metrics, os.path.join(out, METRICS))
-    checkpoint.save(out, step, exported, {"env": env_settings(env), "exported_from": record["run_dir"]})
-    write_json(os.path.join(out, EXPORT), record)
+    parent = os.path.dirname(os.path.abspath(out))
+    os.makedirs(parent, exist_ok=True)
+    tmp = tempfile.mkdtemp(prefix=f".{os.path.basename(out)}.export-", dir=parent)
+    try:  # written aside and renamed into place whole: a failed export leaves no half of one behind
+        write_json(os.path.join(tmp, "config.json"), small.to_json())
+        metrics = os.path.join(run_dir, METRICS)
+        if os.path.isfile(metrics):
+            shutil.copyfile(metrics, os.path.join(tmp, METRICS))
+        checkpoint.save(tmp, step, exported, {"env": env_settings(env), "exported_from": record["run_dir"]})
+        write_json(os.path.join(tmp, EXPORT), record)
+        os.chmod(tmp, 0o777 & ~_umask())
+        try:
+            os.rename(tmp, out)
+        except OSError as e:
+            if e.errno not in (errno.EEXIST, errno.ENOTEMPTY, errno.EISDIR):
+                raise
+            why = "a directory that does not exist yet (another export wrote it meanwhile)"
+            raise InvalidConfig("out", out, why) from None
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
     return record
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -70,11 +91,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     from splid_jax.reference.extra import EvaluationError
-    from splid_jax.runtime.checkpoint import CheckpointError
+    from splid_jax.runtime.checkpoint import CheckpointError, is_no_space, write_failure
 
     ns = build_parser().parse_args(argv)
     names = [os.path.basename(os.path.abspath(d)) for d in ns.run_dirs]
     try:
+        check(bool(ns.out.strip()), "out", ns.out, "a directory to write the exports in")
         check(len(set(names)) == len(names), "run_dirs", " ".join(ns.run_dirs), "runs of distinct directory names")
         for run_dir, name in zip(ns.run_dirs, names, strict=True):
             record = export(run_dir, os.path.join(ns.out, name), ns.step)
@@ -82,6 +104,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (InvalidConfig, EvaluationError, CheckpointError) as e:
         print(f"python -m splid_jax.export: error: {e}", file=sys.stderr)
         return 2
+    except Exception as e:  # a full or read-only disk under --out: nothing of that export is left behind
+        failure = write_failure(e)
+        if failure is None:
+            raise
+        why = "no space left on the device" if is_no_space(e) else failure[1]
+        print(f"python -m splid_jax.export: error: cannot write in {ns.out} ({why})", file=sys.stderr)
+        return 3
     return 0
 
 

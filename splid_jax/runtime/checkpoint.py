@@ -260,6 +260,10 @@ def _restore_target(like_state: Any) -> Any:
     return jax.tree.map(target, like_state)
 
 
+class Rotated(CheckpointError):
+    """The checkpoint being read was removed meanwhile: the run writing it kept newer ones instead."""
+
+
 def restore(
     run_dir: str | Path,
     like_state: Any,
@@ -270,8 +274,24 @@ def restore(
 
     ``like_state`` may be concrete or abstract (``jax.eval_shape``). Returns ``(step, state, meta)``.
     ``expect_meta`` must match the saved meta (its keys; the saved meta may hold more).
-    Every failure is a one-line ``CheckpointError`` so the trainer can print it and stop.
+    Every failure is a one-line ``CheckpointError`` so the trainer can print it and stop. The newest
+    checkpoint of a run still training may be rotated out while it is read: the then newest is read.
     """
+    last = MAX_TO_KEEP + 1
+    for attempt in range(last + 1):
+        try:
+            return _restore(run_dir, like_state, expect_meta, step)
+        except Rotated:
+            if step is not None or attempt == last:
+                raise
+        except FileNotFoundError as e:  # a step removed while orbax listed the steps
+            if step is not None or attempt == last:
+                why = f"the checkpoints in {checkpoint_dir(run_dir)} changed while read ({_one_line(e)})"
+                raise Rotated(why) from e
+    raise AssertionError("unreachable")
+
+
+def _restore(run_dir, like_state, expect_meta, step) -> tuple[int, Any, dict[str, Any]]:
     directory = checkpoint_dir(run_dir)
     if not directory.is_dir():
         raise CheckpointError(f"no checkpoint in {directory}: directory does not exist")
@@ -288,6 +308,8 @@ def restore(
         others = [s for s in steps if s != step]
 
         def corrupt(reason: BaseException | str) -> CheckpointError:
+            if not (directory / str(step)).is_dir():
+                return Rotated(f"{where} was removed while it was read (the run writing it rotated it out)")
             reason = _one_line(reason) if isinstance(reason, BaseException) else reason
             hint = f"; other steps: {others}" if others else ""
             return CheckpointError(f"{where} is corrupt or unreadable ({reason}){hint}")

@@ -98,11 +98,29 @@ def holds_run(run_dir: str) -> bool:
     return checkpoint.latest_step(run_dir) is not None
 
 
+def enclosing_run(path: str) -> str | None:
+    """The nearest directory above ``path`` that holds a run or a sweep (its config.json beside its
+    metrics or checkpoints, or a sweep.json), or None: a run made in another's directory goes with it
+    when that one rotates a checkpoint out or is deleted."""
+    here = os.path.dirname(os.path.abspath(path))
+    while True:
+        marks = [os.path.exists(os.path.join(here, f)) for f in ("config.json", METRICS, "checkpoints", SWEEP)]
+        if (marks[0] and (marks[1] or marks[2])) or marks[3]:
+            return here
+        parent = os.path.dirname(here)
+        if parent == here:
+            return None
+        here = parent
+
+
 def check_run_dir(cfg: TrainConfig, resume: bool) -> int | None:
     """Refuses a run that would overwrite another, or a resume to fewer iterations than done;
     returns the step a resume starts from, None where the run stopped before its first whole
     checkpoint (it then starts again, its records dropped)."""
     if not resume:
+        outer = enclosing_run(cfg.run_dir)
+        if outer is not None:
+            raise InvalidConfig("run_dir", cfg.run_dir, f"a directory outside any other run (it lies in {outer})")
         hint = f"; to continue that run: --resume {cfg.run_dir}"
         if os.path.isdir(cfg.run_dir) and checkpoint.latest_step(cfg.run_dir) is not None:
             why = f"a directory without a run in it (it holds a checkpoint{hint})"

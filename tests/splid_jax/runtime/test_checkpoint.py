@@ -279,3 +279,27 @@ def test_orbax_thread_tracebacks_and_closed_loop_callbacks_are_not_printed():
     for text in ("Event loop is closed", "another"):
         hook(type("U", (), {"exc_value": RuntimeError(text)})())
     assert [str(u.exc_value) for u in seen] == ["another"]
+
+
+def test_a_checkpoint_rotated_out_while_read_gives_the_then_newest(tmp_path, monkeypatch):
+    import shutil
+
+    import orbax.checkpoint as ocp
+
+    for step in (1, 2, 3):
+        ck.save(tmp_path, step, make_state(step, obs_shape=(4, 5)), META)
+    real, removed = ocp.CheckpointManager.restore, []
+
+    def rotating(self, step, *a, **kw):  # the run writing them saves 4 and drops 1..3 meanwhile
+        if not removed:
+            removed.append(step)
+            shutil.rmtree(tmp_path / "checkpoints" / str(step))
+        return real(self, step, *a, **kw)
+
+    monkeypatch.setattr(ocp.CheckpointManager, "restore", rotating)
+    step, state, _ = ck.restore(tmp_path, make_state(0, obs_shape=(4, 5)))
+    assert removed == [3] and step == 2
+    np.testing.assert_array_equal(state.buffer.obs, make_state(2, obs_shape=(4, 5)).buffer.obs)
+    removed.clear()
+    with pytest.raises(ck.Rotated, match="removed while it was read"):  # a step asked for is not replaced
+        ck.restore(tmp_path, make_state(0, obs_shape=(4, 5)), step=2)

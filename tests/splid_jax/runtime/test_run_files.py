@@ -82,3 +82,26 @@ def test_a_run_killed_before_its_first_checkpoint_starts_again_on_resume(tmp_pat
         done = iterations(path)
         assert done and done == list(range(5, done[-1] + 1, 5)), path
         assert checkpoint.latest_step(os.path.dirname(os.path.dirname(path))) in (done[-1], None)
+
+
+@pytest.mark.parametrize("inside", ["R0/checkpoints/10", "R0/sub/run", "S/member/run"])
+def test_a_run_dir_inside_another_run_is_refused(tmp_path, capsys, inside):
+    (tmp_path / "R0" / "checkpoints" / "10").mkdir(parents=True)
+    (tmp_path / "R0" / "config.json").write_text("{}")
+    (tmp_path / "S" / "member").mkdir(parents=True)
+    (tmp_path / "S" / "sweep.json").write_text("{}")
+    run_dir = tmp_path / inside
+    assert train.main(["--env", "point", "--iterations", "5", "--run-dir", str(run_dir)]) == 2
+    err = capsys.readouterr().err.strip()
+    outer = tmp_path / inside.split("/")[0]
+    assert len(err.splitlines()) == 1 and f"outside any other run (it lies in {outer})" in err
+    assert not (run_dir / "metrics.jsonl").exists()
+
+
+def test_a_config_json_alone_makes_no_run_to_stay_out_of(tmp_path):
+    from splid_jax.runtime.run_files import enclosing_run
+
+    (tmp_path / "config.json").write_text("{}")  # some other program's
+    assert enclosing_run(str(tmp_path / "runs" / "a")) is None
+    (tmp_path / "metrics.jsonl").write_text("")
+    assert enclosing_run(str(tmp_path / "runs" / "a")) == str(tmp_path)
