@@ -94,8 +94,8 @@ def load_run(run_dir: str) -> Run:
             with open(config_path) as fh:
                 loaded = json.load(fh)
             config = loaded if isinstance(loaded, dict) else {}
-        except json.JSONDecodeError:
-            config = {}  # the label falls back to the directory name
+        except ValueError:  # not JSON, or not UTF-8: the label falls back to the directory name
+            config = {}
     return Run(run_dir, config, columns)
 
 

@@ -234,7 +234,7 @@ def resume_configs(run_dir: str, given: dict) -> tuple[TrainConfig, list[TrainCo
             TrainConfig.from_json({**m, **given, "run_dir": os.path.join(run_dir, m["run_dir"])})
             for m in saved["members"]
         ]
-    except (OSError, json.JSONDecodeError, KeyError, TypeError) as e:
+    except (OSError, ValueError, KeyError, TypeError) as e:  # ValueError: not UTF-8, not JSON
         why = f" that can be read ({e.strerror})" if isinstance(e, OSError) and e.errno != errno.ENOENT else ""
         raise InvalidConfig("resume", run_dir, f"a sweep directory holding its {run_files.SWEEP}{why}") from None
     return base, lanes

@@ -100,7 +100,7 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
         with open(path) as fh:
             saved = json.load(fh)
         unknown = sorted(set(saved) - names - set(PROVENANCE)) if isinstance(saved, dict) else ["(not an object)"]
-    except (OSError, json.JSONDecodeError):
+    except (OSError, ValueError):  # unreadable, not UTF-8, not JSON
         unknown = ["(not JSON)"]
     if unknown:
         raise InvalidConfig("resume", ns.resume, f"a run whose config.json this version wrote (it has {unknown[0]})")

@@ -22,8 +22,8 @@ def load_record(out: str, field: str = "out") -> dict:
         check(isinstance(record, dict) and record.get("figure") in SPECS, field, out,
               f"a figure directory ({path} names no figure)")  # fmt: skip
         return record
-    except (OSError, json.JSONDecodeError) as e:
-        why = "" if isinstance(e, FileNotFoundError | json.JSONDecodeError) else f" ({e.strerror})"
+    except (OSError, ValueError) as e:  # absent, unreadable, not UTF-8 or not JSON
+        why = "" if isinstance(e, FileNotFoundError | ValueError) else f" ({e.strerror})"
         raise InvalidConfig(field, out, f"a directory holding the {SPEC} a figure command wrote{why}") from None
 
 

@@ -105,3 +105,40 @@ def test_a_config_json_alone_makes_no_run_to_stay_out_of(tmp_path):
     assert enclosing_run(str(tmp_path / "runs" / "a")) is None
     (tmp_path / "metrics.jsonl").write_text("")
     assert enclosing_run(str(tmp_path / "runs" / "a")) == str(tmp_path)
+
+
+def _garbage_run(root, file: str, content: bytes):
+    """A run R and a sweep S with member m0, one of whose files holds ``content``."""
+    for d in ("R", "S/m0", "F"):
+        (root / d).mkdir(parents=True)
+    config = json.dumps({"env": "point", "iterations": 5})
+    for path in ("R/config.json", "S/m0/config.json"):
+        (root / path).write_text(config)
+    (root / "R" / "metrics.jsonl").write_text('{"iteration": 5}\n')
+    (root / "S" / "sweep.json").write_text(json.dumps({"config": {"env": "point"}, "members": [{"run_dir": "m0"}]}))
+    (root / "F" / "figure.json").write_text(json.dumps({"figure": "fig8"}))
+    (root / file).write_bytes(content)
+
+
+GARBAGE = [  # (file, the command reading it, given the root)
+    ("R/config.json", "rollout", lambda r: [f"{r}/R"]),
+    ("R/config.json", "export", lambda r: [f"{r}/R", "--out", f"{r}/out"]),
+    ("R/config.json", "train", lambda r: ["--resume", f"{r}/R"]),
+    ("R/metrics.jsonl", "plot", lambda r: [f"{r}/R"]),
+    ("F/figure.json", "figures", lambda r: ["fig8", "--out", f"{r}/F", "--replot"]),
+    ("F/figure.json", "figures", lambda r: ["fig8", "--out", f"{r}/F", "--resume"]),
+    ("S/sweep.json", "sweep", lambda r: ["--resume", f"{r}/S"]),
+    ("S/sweep.json", "export", lambda r: [f"{r}/S/m0", "--out", f"{r}/out"]),
+]
+
+
+@pytest.mark.parametrize("content", [b'{"env": "\xff"}', b"[1, 2]"], ids=["not-utf8", "a-list"])
+@pytest.mark.parametrize("file, command, argv", GARBAGE, ids=[f"{c}-{f}-{i}" for i, (f, c, _) in enumerate(GARBAGE)])
+def test_an_undecodable_or_foreign_file_is_one_line_and_exit_2(tmp_path, capsys, content, file, command, argv):
+    import importlib
+
+    _garbage_run(tmp_path, file, content)
+    assert importlib.import_module(f"splid_jax.{command}").main(argv(tmp_path)) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
+    assert not (tmp_path / "out").exists()
