@@ -18,7 +18,7 @@ import sys
 import tempfile
 from collections.abc import Sequence
 
-from splid_jax.cli import Parser, exit_with, quiet_interrupts
+from splid_jax.cli import Parser, check_environment, exit_with, quiet_interrupts, run_main
 from splid_jax.common.errors import InvalidConfig, check
 from splid_jax.common.values import options_text
 from splid_jax.runtime.run_files import EXPORT, METRICS, env_settings, write_json
@@ -115,5 +115,6 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    quiet_interrupts()
-    exit_with(main())
+    quiet_interrupts("")
+    check_environment()
+    exit_with(run_main(main))

@@ -7,26 +7,32 @@ compare select and no-select runs at equal simulation cost) and wall-clock secon
 
 from __future__ import annotations
 
-import argparse
-import dataclasses
-import json
-import os
-import sys
-from collections.abc import Sequence
+from splid_jax.cli import check_environment, exit_with, quiet_interrupts, run_main
 
-import matplotlib
-import numpy as np
-from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
-from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg
+if __name__ == "__main__":  # a signal while it loads or works ends the process with one line, no traceback
+    quiet_interrupts("")
+    check_environment()
 
-from splid_jax.cli import Parser
-from splid_jax.common import stats
-from splid_jax.common.paths import unreadable
-from splid_jax.common.stats import smooth
-from splid_jax.config import PROVENANCE, TrainConfig
-from splid_jax.learners import registry
-from splid_jax.runtime import progress
+import argparse  # noqa: E402
+import dataclasses  # noqa: E402
+import json  # noqa: E402
+import os  # noqa: E402
+import sys  # noqa: E402
+from collections.abc import Sequence  # noqa: E402
+
+import matplotlib  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg  # noqa: E402
+
+from splid_jax.cli import Parser  # noqa: E402
+from splid_jax.common import stats  # noqa: E402
+from splid_jax.common.paths import unreadable  # noqa: E402
+from splid_jax.common.stats import smooth  # noqa: E402
+from splid_jax.config import PROVENANCE, TrainConfig  # noqa: E402
+from splid_jax.learners import registry  # noqa: E402
+from splid_jax.runtime import progress  # noqa: E402
 
 DESCRIPTION = (
     "Learning curves of one or more runs: evaluation success (solid: at any step, dashed: at the final step) "
@@ -277,4 +283,4 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    exit_with(run_main(main))

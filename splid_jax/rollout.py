@@ -4,26 +4,32 @@ through MuJoCo's offscreen renderer (headless: set MUJOCO_GL=egl, or osmesa with
 
 from __future__ import annotations
 
-import argparse
-import json
-import os
-import sys
-import warnings
+from splid_jax.cli import check_environment, exit_with, quiet_interrupts, run_main
 
-import jax
-import jax.numpy as jnp
-import numpy as np
+if __name__ == "__main__":  # a signal while it loads or works ends the process with one line, no traceback
+    quiet_interrupts("")
+    check_environment()
 
-from envs.base import step_batch
-from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache
-from splid_jax.common.errors import InvalidConfig
-from splid_jax.common.paths import unreadable
-from splid_jax.common.subgoals import steered
-from splid_jax.config import TrainConfig
-from splid_jax.learners.registry import make_algorithm
-from splid_jax.runtime import checkpoint
-from splid_jax.runtime.memory import device_memory, gigabytes, nbytes
-from splid_jax.runtime.run_files import note_task_changes
+import argparse  # noqa: E402
+import json  # noqa: E402
+import os  # noqa: E402
+import sys  # noqa: E402
+import warnings  # noqa: E402
+
+import jax  # noqa: E402
+import jax.numpy as jnp  # noqa: E402
+import numpy as np  # noqa: E402
+
+from envs.base import step_batch  # noqa: E402
+from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache  # noqa: E402
+from splid_jax.common.errors import InvalidConfig  # noqa: E402
+from splid_jax.common.paths import unreadable  # noqa: E402
+from splid_jax.common.subgoals import steered  # noqa: E402
+from splid_jax.config import TrainConfig  # noqa: E402
+from splid_jax.learners.registry import make_algorithm  # noqa: E402
+from splid_jax.runtime import checkpoint  # noqa: E402
+from splid_jax.runtime.memory import device_memory, gigabytes, nbytes  # noqa: E402
+from splid_jax.runtime.run_files import note_task_changes  # noqa: E402
 
 DESCRIPTION = (
     "Roll a run's deterministic policy out, report its success and draw the episodes: their paths, "
@@ -349,4 +355,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    exit_with(run_main(main))

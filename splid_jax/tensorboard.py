@@ -9,16 +9,22 @@ Needs the optional extra: ``pip install -e ".[tensorboard]"`` (tensorboardX).
 
 from __future__ import annotations
 
-import argparse
-import contextlib
-import math
-import os
-import sys
-import time
-from collections.abc import Callable, Iterator
+from splid_jax.cli import check_environment, exit_with, quiet_interrupts, run_main
 
-from splid_jax.common.errors import InvalidConfig
-from splid_jax.common.paths import unwritable
+if __name__ == "__main__":  # a signal while it loads or works ends the process with one line, no traceback
+    quiet_interrupts("")
+    check_environment()
+
+import argparse  # noqa: E402
+import contextlib  # noqa: E402
+import math  # noqa: E402
+import os  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from collections.abc import Callable, Iterator  # noqa: E402
+
+from splid_jax.common.errors import InvalidConfig  # noqa: E402
+from splid_jax.common.paths import unwritable  # noqa: E402
 
 STEP_KEY = "episodes"
 EXTRA = 'pip install -e ".[tensorboard]"'
@@ -148,4 +154,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    exit_with(run_main(main))

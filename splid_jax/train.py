@@ -6,10 +6,11 @@ by signal keeps the newest whole state as a checkpoint to --resume from."""
 
 from __future__ import annotations
 
-from splid_jax.cli import exit_with, quiet_interrupts
+from splid_jax.cli import check_environment, exit_with, quiet_interrupts, run_main
 
 if __name__ == "__main__":  # a signal while JAX loads ends the process with one line, no traceback
     quiet_interrupts()
+    check_environment()
 
 import argparse  # noqa: E402
 import dataclasses  # noqa: E402
@@ -24,6 +25,7 @@ from splid_jax.cli import (  # noqa: E402
     add_config_flags,
     add_launch_flags,
     explicit_values,
+    interrupts_now,
     refuse_unread,
     start_processes,
     use_compile_cache,
@@ -121,6 +123,7 @@ def main(argv: list[str] | None = None) -> int:
         env = cfg.make_env()
         cfg.check_env(env)
         rec = run(cfg, env, resume=resume, quiet=ns.quiet, tensorboard=ns.tensorboard)
+        interrupts_now(f"after the run completed ({cfg.run_dir} is whole)")
     except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 2
@@ -139,4 +142,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    exit_with(main())
+    exit_with(run_main(main))

@@ -12,7 +12,7 @@ import sys
 from collections.abc import Sequence
 
 import envs
-from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache
+from splid_jax.cli import Parser, add_compile_cache_flag, interrupts_now, use_compile_cache
 from splid_jax.common.errors import InvalidConfig, check
 from splid_jax.figures.drawing import render
 from splid_jax.figures.merging import merge
@@ -159,6 +159,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             else:
                 record = new_record(ns, spec, env_name, out, today, argv)
                 (train_side_by_side if side else train)(out, record, ns.quiet)
+            interrupts_now(f"after training ({out} is whole; --replot draws its figure)")
             png, table = render(out, ns.quiet)
     except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
