@@ -20,6 +20,7 @@ from collections.abc import Sequence
 
 from splid_jax.cli import Parser, check_environment, exit_with, quiet_interrupts, run_main
 from splid_jax.common.errors import InvalidConfig, check
+from splid_jax.common.paths import is_utf8
 from splid_jax.common.values import options_text
 from splid_jax.runtime.run_files import EXPORT, METRICS, env_settings, write_json
 
@@ -97,6 +98,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     names = [os.path.basename(os.path.abspath(d)) for d in ns.run_dirs]
     try:
         check(bool(ns.out.strip()), "out", ns.out, "a directory to write the exports in")
+        check(is_utf8(ns.out), "out", ns.out, "a path of UTF-8 text (checkpoints are written under it)")
         check(len(set(names)) == len(names), "run_dirs", " ".join(ns.run_dirs), "runs of distinct directory names")
         for run_dir, name in zip(ns.run_dirs, names, strict=True):
             record = export(run_dir, os.path.join(ns.out, name), ns.step)

@@ -247,7 +247,9 @@ def _positive_int(text: str) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(prog="python -m splid_jax.plot", description=DESCRIPTION)
     parser.add_argument("run_dirs", nargs="+", metavar="RUN_DIR", help="run directory with metrics.jsonl")
-    parser.add_argument("--out", metavar="FILE.png", help="output image (default: RUN_DIR/curves.png of the first)")
+    parser.add_argument("--out", metavar="FILE.png", help="output image (default: RUN_DIR/curves.png of the first, "
+                        "redrawn each time)")
+    parser.add_argument("--overwrite", action="store_true", help="replace an --out image that already exists")
     parser.add_argument("--smooth", type=_positive_int, default=1, metavar="K", help="trailing mean over K evals")
     parser.add_argument("--group", action="store_true", help="average runs that differ only in seed (min-max band)")
     parser.add_argument(
@@ -270,6 +272,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     formats = Figure().canvas.get_supported_filetypes()
     if os.path.splitext(out)[1].lstrip(".").lower() not in formats:
         print(f"plot: --out {out}: not an image file name (end it in .png, .pdf or .svg)", file=sys.stderr)
+        return 2
+    if ns.out is not None and os.path.exists(out) and not ns.overwrite:
+        print(f"plot: --out {out}: a file that does not exist yet (or pass --overwrite)", file=sys.stderr)
         return 2
     try:
         if os.path.dirname(out):

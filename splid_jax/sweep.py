@@ -301,7 +301,7 @@ def main(argv: list[str] | None = None) -> int:
         return 3
     if not ns.no_plot and multihost.is_first():
         out = os.path.join(cfg.run_dir, "grid.png")
-        plot.main([m.run_dir for m in lanes] + ["--group", "--out", out])
+        plot.main([m.run_dir for m in lanes] + ["--group", "--out", out, "--overwrite"])  # its own, redrawn
         progress.show(f"figure: {out}", ns.quiet)
     return 0
 

@@ -19,6 +19,16 @@ def unreadable(path: str) -> str | None:
     return None if os.access(path, want) else "Permission denied"
 
 
+def is_utf8(path: str) -> bool:
+    """Whether ``path`` is UTF-8 text: a name with other bytes (``\\xff``) cannot reach orbax's and
+    TensorStore's C++ code, which takes UTF-8 strings."""
+    try:
+        path.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
 def missing_parents(path: str) -> list[str]:
     """The directories ``os.makedirs(path)`` would create, deepest first: what to remove again when
     the work they were made for does not happen."""

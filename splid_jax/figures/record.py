@@ -7,6 +7,7 @@ import json
 import os
 
 from splid_jax.common.errors import InvalidConfig, check
+from splid_jax.common.paths import is_utf8
 from splid_jax.figures.registry import SPECS
 from splid_jax.runtime import lock, loop
 
@@ -40,6 +41,7 @@ def sweeps(record: dict) -> list[tuple[str, dict, str]]:
 
 
 def check_out(out: str) -> None:
+    check(is_utf8(out), "out", out, "a path of UTF-8 text (checkpoints are written under it)")
     if os.path.isdir(out) and set(os.listdir(out)) - {lock.LOCK}:
         raise InvalidConfig("out", out, "a new or empty directory (--replot redraws the figure in it)")
     check(not os.path.exists(out) or os.path.isdir(out), "out", out, "a directory, not a file")

@@ -101,8 +101,9 @@ def test_a_failed_export_is_one_line_and_leaves_nothing_half_written(tmp_path, c
         assert export.main([str(run), "--out", str(out)]) == 0
 
 
-def test_an_empty_out_is_refused(tmp_path, capsys, monkeypatch):
+@pytest.mark.parametrize("out", ["", "bad-\udcff"], ids=["empty", "not-utf8"])
+def test_an_empty_or_undecodable_out_is_refused(tmp_path, capsys, monkeypatch, out):
     monkeypatch.chdir(tmp_path)
-    assert export.main([str(tmp_path / "run"), "--out", ""]) == 2
-    assert "invalid out=''" in capsys.readouterr().err
+    assert export.main([str(tmp_path / "run"), "--out", out]) == 2
+    assert f"invalid out={out!r}" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []

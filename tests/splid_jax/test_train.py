@@ -80,6 +80,7 @@ def final_params(run_dir):
         (["--sigma", "nan"], "sigma"),
         (["--num-envs", "100000000"], "num_envs"),  # refused from its shapes, before anything is allocated
         (["--run-dir", ""], "run_dir"),
+        (["--run-dir", "bad-\udcff"], "run_dir"),  # a \xff byte in the name: orbax takes UTF-8 paths only
         (["--bc-steps", "0"], "bc_steps"),  # no cloning step: the loss would be undefined
         (["--gcsl-relabel", "future"], "gcsl_relabel"),  # flags the learner does not read
         (["--pchid-every", "3"], "pchid_every"),
