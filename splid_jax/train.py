@@ -1,8 +1,8 @@
 """``python -m splid_jax.train --env ENV``: train one run through the host loop (``splid_jax.runtime.loop``).
 
 Exit codes: 0 done (or already complete), 2 a mistake in the command line (one line naming the
-field, nothing written), 3 stopped (NaN, unreadable checkpoint), 130 Ctrl-C, 143 SIGTERM; a stop
-by signal keeps the newest whole state as a checkpoint to --resume from."""
+field, nothing written), 3 stopped (NaN, unreadable checkpoint, a full or read-only disk), 130 Ctrl-C,
+143 SIGTERM; a stop by signal keeps the newest whole state as a checkpoint to --resume from."""
 
 from __future__ import annotations
 
@@ -61,7 +61,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog="python -m splid_jax.train",
         description="Train a goal-conditioned policy: SPLID (explore, SELECT by first hit time, behaviour "
         "cloning) or a baseline of the paper's comparison (--algo).",
-        epilog="Exit codes: 0 done, 2 bad input (nothing written), 3 stopped on NaN or an unreadable checkpoint, "
+        epilog="Exit codes: 0 done, 2 bad input (nothing written), 3 stopped on NaN, an unreadable checkpoint or a "
+        "disk refusing a write (the last whole checkpoint kept), "
         "130 Ctrl-C, 143 SIGTERM (both keep the newest whole state as a checkpoint for --resume).",
     )
     add_config_flags(parser, TrainConfig, TASK_DEFAULTS, per_algo=registry.task_defaults())

@@ -45,8 +45,8 @@ subsets, each in its own --out, and joined with --merge (figN --merge DIR1 DIR2 
 fig3 --side-by-side trains its methods at once, one process each: on a GPU under CUDA MPS
 (nvidia-cuda-mps-control -d) they share it, where in turn their times add up; on several GPUs each
 process takes one, the heaviest first, and HER's and SPLID's seeds are split while GPUs are to spare.
-Exit codes: 0 done, 2 bad input (nothing trained), 3 a run stopped (NaN), 130 Ctrl-C, 143 SIGTERM
-(each method's newest state is kept; --resume continues)."""
+Exit codes: 0 done, 2 bad input (nothing trained), 3 a run stopped (NaN, a full or read-only disk), 130 Ctrl-C,
+143 SIGTERM (each method's newest state is kept; --resume continues)."""
 
 
 def build_parser() -> Parser:
