@@ -384,6 +384,7 @@ def test_a_torn_record_at_the_checkpoint_is_warned_of(tmp_path, capsys):
     assert len(err.splitlines()) == 1 and "ends at iteration 5" in err and "6-10 are lost" in err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "error, said",
     [

@@ -3,6 +3,8 @@
 import os
 import sys
 
+import pytest
+
 from splid_jax import train
 from splid_jax.runtime import checkpoint
 
@@ -10,6 +12,7 @@ SMALL = ["--env", "point", "--num-envs", "4", "--eval-episodes", "8", "--eval-ev
          "--batch-size", "16", "--hidden", "16", "--iterations", "10"]  # fmt: skip
 
 
+@pytest.mark.slow
 def test_a_closed_stdout_quiets_the_display_and_the_run_goes_on(tmp_path, monkeypatch, capfd):
     read, write = os.pipe()
     os.close(read)  # the reader is gone, as `| head -3` leaves it after three lines

@@ -63,6 +63,7 @@ def iterations(path: str) -> list[int]:
         return [json.loads(line)["iteration"] for line in fh]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", sorted(COMMANDS))
 def test_a_run_killed_before_its_first_checkpoint_starts_again_on_resume(tmp_path, capsys, command):
     module, first, again = COMMANDS[command]

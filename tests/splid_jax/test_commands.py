@@ -16,6 +16,7 @@ def python(code: str, *args: str, env: dict | None = None) -> subprocess.Complet
                           env={**os.environ, **(env or {})}, cwd=ROOT)  # fmt: skip
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("variable", ["MUJOCO_GL", "JAX_PLATFORMS"])
 def test_a_bad_environment_variable_is_one_line_naming_it(tmp_path, variable):
     run = "import runpy; runpy.run_module('splid_jax.train', run_name='__main__', alter_sys=True)"
@@ -39,6 +40,7 @@ def test_a_signal_while_python_shuts_down_after_the_work_is_ignored():
     assert done.returncode == 0 and done.stderr == ""
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["plot", "rollout"])
 def test_ctrl_c_in_a_command_that_trains_nothing_is_one_line(tmp_path, command):
     stops_at_parse = ("import argparse, os, runpy, signal, sys, time\n"
