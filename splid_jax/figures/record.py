@@ -43,6 +43,7 @@ def sweeps(record: dict) -> list[tuple[str, dict, str]]:
 def check_out(out: str) -> None:
     check(is_utf8(out), "out", out, "a path of UTF-8 text (checkpoints are written under it)")
     if os.path.isdir(out) and set(os.listdir(out)) - {lock.LOCK}:
-        raise InvalidConfig("out", out, "a new or empty directory (--replot redraws the figure in it)")
+        why = "a new or empty directory (--resume continues the figure in it, --replot redraws it)"
+        raise InvalidConfig("out", out, why)
     check(not os.path.exists(out) or os.path.isdir(out), "out", out, "a directory, not a file")
     loop.check_writable(out)
