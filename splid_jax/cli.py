@@ -6,22 +6,74 @@ signal while JAX loads can already be handled."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import os
 import signal
 import sys
 
+_INTERRUPTED = {"when": ""}  # what a signal outside a run's own handlers cuts short, said in its line
 
-def quiet_interrupts() -> None:
-    """Until a run installs its own handlers, SIGINT and SIGTERM end the process at once with one
-    line and no traceback (exit 130 / 143): nothing has been written yet that a stop could tear."""
+
+def quiet_interrupts(when: str = "before the run started") -> None:
+    """Outside a run's own handlers (before it, after it), SIGINT and SIGTERM end the process at once
+    with one line and no traceback (exit 130 / 143): no write is under way that a stop could tear.
+    ``when``: what the line says was cut short (``interrupts_now``)."""
 
     def stop(signum, frame):
-        os.write(2, f"interrupted ({signal.Signals(signum).name}) before the run started\n".encode())
+        when = _INTERRUPTED["when"]
+        os.write(2, f"interrupted ({signal.Signals(signum).name}){' ' + when if when else ''}\n".encode())
         os._exit(128 + signum)
 
+    interrupts_now(when)
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, stop)
+
+
+def interrupts_now(when: str) -> None:
+    """What ``quiet_interrupts``' line says from now on, e.g. that the run is complete and whole."""
+    _INTERRUPTED["when"] = when
+
+
+def check_environment() -> None:
+    """A MUJOCO_GL naming an OpenGL backend MuJoCo cannot load here (absent, or not one it knows) fails
+    every command as MuJoCo is imported: one line naming the variable, exit 2."""
+    gl = os.environ.get("MUJOCO_GL")
+    if not gl:
+        return
+    try:
+        import mujoco  # noqa: F401
+    except Exception as e:
+        print(f"error: MUJOCO_GL={gl!r}: MuJoCo cannot load that OpenGL backend here ({_first_line(e)}); unset it, "
+              "or set egl or osmesa where its library is installed", file=sys.stderr)  # fmt: skip
+        raise SystemExit(2) from None
+
+
+def run_main(main) -> int:
+    """``main()``, where a backend that JAX_PLATFORMS names but JAX cannot start here is one line naming
+    the variable, exit 2 (JAX finds out at its first use of a device, before the run writes anything)."""
+    try:
+        return main()
+    except (RuntimeError, AssertionError) as e:
+        platforms = os.environ.get("JAX_PLATFORMS")
+        if not platforms or not _from_backend_start(e):
+            raise
+        print(f"error: JAX_PLATFORMS={platforms!r}: JAX cannot start that backend here ({_first_line(e)}); "
+              "unset it to use what this machine has", file=sys.stderr)  # fmt: skip
+        return 2
+
+
+def _from_backend_start(e: BaseException) -> bool:
+    tb = e.__traceback__
+    while tb is not None and tb.tb_next is not None:
+        tb = tb.tb_next
+    where = tb.tb_frame.f_code.co_filename if tb is not None else ""
+    return "Unable to initialize backend" in str(e) or where.endswith("xla_bridge.py")
+
+
+def _first_line(e: BaseException) -> str:
+    lines = str(e).strip().splitlines()
+    return f"{type(e).__name__}: {lines[0][:200]}" if lines else type(e).__name__
 
 
 class Parser(argparse.ArgumentParser):
@@ -197,9 +249,13 @@ def start_processes(ns: argparse.Namespace) -> None:
 
 def exit_with(code: int) -> None:
     """Exit with ``code``; after a signal (130, 143) at once: the chunk or compilation the signal cut
-    short may still run in a worker thread."""
+    short may still run in a worker thread. Otherwise the work is done, and a signal while Python shuts
+    down (which puts the default handlers back, so the process would die by it, silently) is ignored."""
     if code in (130, 143):
-        sys.stdout.flush()
-        sys.stderr.flush()
+        with contextlib.suppress(OSError, ValueError):
+            sys.stdout.flush()
+            sys.stderr.flush()
         os._exit(code)
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, signal.SIG_IGN)
     raise SystemExit(code)

@@ -16,6 +16,7 @@ from typing import Any
 import envs
 from splid_jax.common.errors import check
 from splid_jax.common.fields import field
+from splid_jax.common.paths import is_utf8
 from splid_jax.common.values import format_overrides, options_text, parse_options, parse_overrides
 from splid_jax.learners import registry
 
@@ -293,6 +294,7 @@ class TrainConfig:
         if self.run_dir is None:
             object.__setattr__(self, "run_dir", os.path.join("runs", f"{self.env}-s{self.seed}"))
         check(self.run_dir.strip() != "", "run_dir", self.run_dir, "a directory name, not empty")
+        check(is_utf8(self.run_dir), "run_dir", self.run_dir, "a path of UTF-8 text (checkpoints are written by it)")
         check(not os.path.isfile(self.run_dir), "run_dir", self.run_dir, "a directory, not an existing file")
 
     def env_overrides(self) -> dict[str, Any]:

@@ -11,13 +11,16 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import errno
 import os
 import shutil
 import sys
+import tempfile
 from collections.abc import Sequence
 
-from splid_jax.cli import Parser, exit_with, quiet_interrupts
+from splid_jax.cli import Parser, check_environment, exit_with, quiet_interrupts, run_main
 from splid_jax.common.errors import InvalidConfig, check
+from splid_jax.common.paths import is_utf8
 from splid_jax.common.values import options_text
 from splid_jax.runtime.run_files import EXPORT, METRICS, env_settings, write_json
 
@@ -50,14 +53,33 @@ def export(run_dir: str, out: str, step: int | None = None) -> dict:
     like = make_algorithm(small, env).init(jax.random.PRNGKey(0))
     exported = like.replace(policy=state.policy)
     record = {"run_dir": os.path.abspath(run_dir), "step": int(step), "config": cfg.to_json()}
-    os.makedirs(out)
-    write_json(os.path.join(out, "config.json"), small.to_json())
-    metrics = os.path.join(run_dir, METRICS)
-    if os.path.isfile(metrics):
-        shutil.copyfile(metrics, os.path.join(out, METRICS))
-    checkpoint.save(out, step, exported, {"env": env_settings(env), "exported_from": record["run_dir"]})
-    write_json(os.path.join(out, EXPORT), record)
+    parent = os.path.dirname(os.path.abspath(out))
+    os.makedirs(parent, exist_ok=True)
+    tmp = tempfile.mkdtemp(prefix=f".{os.path.basename(out)}.export-", dir=parent)
+    try:  # written aside and renamed into place whole: a failed export leaves no half of one behind
+        write_json(os.path.join(tmp, "config.json"), small.to_json())
+        metrics = os.path.join(run_dir, METRICS)
+        if os.path.isfile(metrics):
+            shutil.copyfile(metrics, os.path.join(tmp, METRICS))
+        checkpoint.save(tmp, step, exported, {"env": env_settings(env), "exported_from": record["run_dir"]})
+        write_json(os.path.join(tmp, EXPORT), record)
+        os.chmod(tmp, 0o777 & ~_umask())
+        try:
+            os.rename(tmp, out)
+        except OSError as e:
+            if e.errno not in (errno.EEXIST, errno.ENOTEMPTY, errno.EISDIR):
+                raise
+            why = "a directory that does not exist yet (another export wrote it meanwhile)"
+            raise InvalidConfig("out", out, why) from None
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
     return record
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -70,11 +92,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     from splid_jax.reference.extra import EvaluationError
-    from splid_jax.runtime.checkpoint import CheckpointError
+    from splid_jax.runtime.checkpoint import CheckpointError, is_no_space, write_failure
 
     ns = build_parser().parse_args(argv)
     names = [os.path.basename(os.path.abspath(d)) for d in ns.run_dirs]
     try:
+        check(bool(ns.out.strip()), "out", ns.out, "a directory to write the exports in")
+        check(is_utf8(ns.out), "out", ns.out, "a path of UTF-8 text (checkpoints are written under it)")
         check(len(set(names)) == len(names), "run_dirs", " ".join(ns.run_dirs), "runs of distinct directory names")
         for run_dir, name in zip(ns.run_dirs, names, strict=True):
             record = export(run_dir, os.path.join(ns.out, name), ns.step)
@@ -82,9 +106,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (InvalidConfig, EvaluationError, CheckpointError) as e:
         print(f"python -m splid_jax.export: error: {e}", file=sys.stderr)
         return 2
+    except Exception as e:  # a full or read-only disk under --out: nothing of that export is left behind
+        failure = write_failure(e)
+        if failure is None:
+            raise
+        why = "no space left on the device" if is_no_space(e) else failure[1]
+        print(f"python -m splid_jax.export: error: cannot write in {ns.out} ({why})", file=sys.stderr)
+        return 3
     return 0
 
 
 if __name__ == "__main__":
-    quiet_interrupts()
-    exit_with(main())
+    quiet_interrupts("")
+    check_environment()
+    exit_with(run_main(main))

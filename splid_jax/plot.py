@@ -7,26 +7,32 @@ compare select and no-select runs at equal simulation cost) and wall-clock secon
 
 from __future__ import annotations
 
-import argparse
-import dataclasses
-import json
-import os
-import sys
-from collections.abc import Sequence
+from splid_jax.cli import check_environment, exit_with, quiet_interrupts, run_main
 
-import matplotlib
-import numpy as np
-from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
-from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg
+if __name__ == "__main__":  # a signal while it loads or works ends the process with one line, no traceback
+    quiet_interrupts("")
+    check_environment()
 
-from splid_jax.cli import Parser
-from splid_jax.common import stats
-from splid_jax.common.paths import unreadable
-from splid_jax.common.stats import smooth
-from splid_jax.config import PROVENANCE, TrainConfig
-from splid_jax.learners import registry
-from splid_jax.runtime import progress
+import argparse  # noqa: E402
+import dataclasses  # noqa: E402
+import json  # noqa: E402
+import os  # noqa: E402
+import sys  # noqa: E402
+from collections.abc import Sequence  # noqa: E402
+
+import matplotlib  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state, renders with Agg  # noqa: E402
+
+from splid_jax.cli import Parser  # noqa: E402
+from splid_jax.common import stats  # noqa: E402
+from splid_jax.common.paths import unreadable  # noqa: E402
+from splid_jax.common.stats import smooth  # noqa: E402
+from splid_jax.config import PROVENANCE, TrainConfig  # noqa: E402
+from splid_jax.learners import registry  # noqa: E402
+from splid_jax.runtime import progress  # noqa: E402
 
 DESCRIPTION = (
     "Learning curves of one or more runs: evaluation success (solid: at any step, dashed: at the final step) "
@@ -94,8 +100,8 @@ def load_run(run_dir: str) -> Run:
             with open(config_path) as fh:
                 loaded = json.load(fh)
             config = loaded if isinstance(loaded, dict) else {}
-        except json.JSONDecodeError:
-            config = {}  # the label falls back to the directory name
+        except ValueError:  # not JSON, or not UTF-8: the label falls back to the directory name
+            config = {}
     return Run(run_dir, config, columns)
 
 
@@ -241,7 +247,9 @@ def _positive_int(text: str) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(prog="python -m splid_jax.plot", description=DESCRIPTION)
     parser.add_argument("run_dirs", nargs="+", metavar="RUN_DIR", help="run directory with metrics.jsonl")
-    parser.add_argument("--out", metavar="FILE.png", help="output image (default: RUN_DIR/curves.png of the first)")
+    parser.add_argument("--out", metavar="FILE.png", help="output image (default: RUN_DIR/curves.png of the first, "
+                        "redrawn each time)")
+    parser.add_argument("--overwrite", action="store_true", help="replace an --out image that already exists")
     parser.add_argument("--smooth", type=_positive_int, default=1, metavar="K", help="trailing mean over K evals")
     parser.add_argument("--group", action="store_true", help="average runs that differ only in seed (min-max band)")
     parser.add_argument(
@@ -265,6 +273,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if os.path.splitext(out)[1].lstrip(".").lower() not in formats:
         print(f"plot: --out {out}: not an image file name (end it in .png, .pdf or .svg)", file=sys.stderr)
         return 2
+    if ns.out is not None and os.path.exists(out) and not ns.overwrite:
+        print(f"plot: --out {out}: a file that does not exist yet (or pass --overwrite)", file=sys.stderr)
+        return 2
     try:
         if os.path.dirname(out):
             os.makedirs(os.path.dirname(out), exist_ok=True)
@@ -272,9 +283,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as e:
         print(f"plot: cannot write {out}: {e.strerror or e}", file=sys.stderr)
         return 2
-    print(out)
+    progress.show(out)
     return 0
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    exit_with(run_main(main))

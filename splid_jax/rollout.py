@@ -4,26 +4,32 @@ through MuJoCo's offscreen renderer (headless: set MUJOCO_GL=egl, or osmesa with
 
 from __future__ import annotations
 
-import argparse
-import json
-import os
-import sys
-import warnings
+from splid_jax.cli import check_environment, exit_with, quiet_interrupts, run_main
 
-import jax
-import jax.numpy as jnp
-import numpy as np
+if __name__ == "__main__":  # a signal while it loads or works ends the process with one line, no traceback
+    quiet_interrupts("")
+    check_environment()
 
-from envs.base import step_batch
-from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache
-from splid_jax.common.errors import InvalidConfig
-from splid_jax.common.paths import unreadable
-from splid_jax.common.subgoals import steered
-from splid_jax.config import TrainConfig
-from splid_jax.learners.registry import make_algorithm
-from splid_jax.runtime import checkpoint
-from splid_jax.runtime.memory import device_memory, gigabytes, nbytes
-from splid_jax.runtime.run_files import note_task_changes
+import argparse  # noqa: E402
+import json  # noqa: E402
+import os  # noqa: E402
+import sys  # noqa: E402
+import warnings  # noqa: E402
+
+import jax  # noqa: E402
+import jax.numpy as jnp  # noqa: E402
+import numpy as np  # noqa: E402
+
+from envs.base import step_batch  # noqa: E402
+from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache  # noqa: E402
+from splid_jax.common.errors import InvalidConfig  # noqa: E402
+from splid_jax.common.paths import unreadable  # noqa: E402
+from splid_jax.common.subgoals import steered  # noqa: E402
+from splid_jax.config import TrainConfig  # noqa: E402
+from splid_jax.learners.registry import make_algorithm  # noqa: E402
+from splid_jax.runtime import checkpoint  # noqa: E402
+from splid_jax.runtime.memory import device_memory, gigabytes, nbytes  # noqa: E402
+from splid_jax.runtime.run_files import note_task_changes  # noqa: E402
 
 DESCRIPTION = (
     "Roll a run's deterministic policy out, report its success and draw the episodes: their paths, "
@@ -45,8 +51,11 @@ def load_config(run_dir: str) -> TrainConfig:
         raise InvalidConfig("run_dir", run_dir, "a run directory holding config.json")
     try:
         with open(path) as fh:
-            return TrainConfig.from_json(json.load(fh), run_dir=run_dir)
-    except (json.JSONDecodeError, TypeError):
+            saved = json.load(fh)
+        if not isinstance(saved, dict):
+            raise TypeError("not an object")
+        return TrainConfig.from_json(saved, run_dir=run_dir)
+    except (ValueError, TypeError):  # not UTF-8, not JSON, not an object of train's fields
         raise InvalidConfig("run_dir", run_dir, "a run directory whose config.json train wrote") from None
 
 
@@ -60,6 +69,59 @@ def load_policy(cfg: TrainConfig, step: int | None = None):
     step, state, meta = checkpoint.restore(cfg.run_dir, like, step=step)
     note_task_changes(cfg.run_dir, meta["env"], env)
     return env, trainer, state, step
+
+
+def sweep_member(run_dir: str) -> tuple[str, int, int] | None:
+    """(sweep directory, member index, members) when ``run_dir`` is a member of a sweep, whose
+    checkpoints the sweep directory holds, stacked over members."""
+    parent = os.path.dirname(os.path.abspath(run_dir))
+    path = os.path.join(parent, "sweep.json")
+    if not os.path.isfile(path):
+        return None
+    try:
+        with open(path) as fh:
+            names = [m.get("run_dir") for m in json.load(fh).get("members", [])]
+    except (OSError, ValueError, AttributeError, TypeError):  # unreadable, not UTF-8, not JSON, not a sweep's
+        raise checkpoint.CheckpointError(f"{path} is not a sweep.json that sweep wrote") from None
+    name = os.path.basename(os.path.abspath(run_dir))
+    return (parent, names.index(name), len(names)) if name in names else None
+
+
+def restore_sweep(directory: str, env=None, step: int | None = None):
+    """(task, algorithm, state stacked over members, step, checkpoint record) of the sweep in ``directory``,
+    laid out as the sweep's own config builds it; ``env``: the task to build the algorithm on (default: the
+    sweep's own)."""
+    with open(os.path.join(directory, "sweep.json")) as fh:
+        saved = json.load(fh)
+    cfg = TrainConfig.from_json(saved["config"], run_dir=directory)
+    env = cfg.make_env() if env is None else env
+    trainer = make_algorithm(cfg, env)
+    members = len(saved.get("members", []))
+    like = jax.eval_shape(jax.vmap(trainer.init), jax.random.split(jax.random.PRNGKey(0), members))
+    step, state, meta = checkpoint.restore(directory, like, step=step)
+    return env, trainer, state, step, meta
+
+
+def restore_member(cfg: TrainConfig, sweep: tuple[str, int, int], step: int | None):
+    """A sweep member's task, algorithm, state and step, sliced out of the sweep's stacked checkpoint
+    (members differ only in data, not in shapes)."""
+    directory, index, _ = sweep
+    env = cfg.make_env()  # the member's task, with any changed fields
+    env, trainer, state, step, meta = restore_sweep(directory, env, step)
+    note_task_changes(cfg.run_dir, meta.get("env", {}), env)
+    return env, trainer, jax.tree.map(lambda x: x[index], state), step
+
+
+def load_trained(cfg: TrainConfig, step: int | None = None):
+    """``load_policy`` of a run of train, or of a sweep member (``cfg.run_dir``), whose state is its slice
+    of the sweep's checkpoint."""
+    if checkpoint.latest_step(cfg.run_dir) is not None:
+        return load_policy(cfg, step)
+    sweep = sweep_member(cfg.run_dir)
+    if sweep is None or checkpoint.latest_step(sweep[0]) is None:
+        where = f"{cfg.run_dir}/checkpoints"
+        raise checkpoint.CheckpointError(f"{cfg.run_dir} holds no checkpoint (train writes them in {where})")
+    return restore_member(cfg, sweep, step)
 
 
 def rollout(env, policy, pstate, key, episodes: int):
@@ -249,7 +311,7 @@ def main(argv: list[str] | None = None) -> int:
         if a.out is not None:
             _check_out(a.out)
         cfg = load_config(a.run_dir)
-        env, trainer, state, step = load_policy(cfg, a.step)
+        env, trainer, state, step = load_trained(cfg, a.step)
         figure, frames_out = _outputs(a.out or os.path.join(a.run_dir, f"rollout-{step}.png"), video)
         check_fits(env, a.episodes)
         _check_folder_writable(figure)
@@ -293,4 +355,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    exit_with(run_main(main))

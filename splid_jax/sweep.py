@@ -10,10 +10,11 @@ under RUN_DIR, so ``--resume RUN_DIR`` continues a sweep as it continues a run."
 
 from __future__ import annotations
 
-from splid_jax.cli import exit_with, quiet_interrupts
+from splid_jax.cli import check_environment, exit_with, quiet_interrupts, run_main
 
 if __name__ == "__main__":  # a signal while JAX loads ends the process with one line, no traceback
     quiet_interrupts()
+    check_environment()
 
 import dataclasses  # noqa: E402
 import errno  # noqa: E402
@@ -31,6 +32,7 @@ from splid_jax.cli import (  # noqa: E402
     add_config_flags,
     add_launch_flags,
     explicit_values,
+    interrupts_now,
     refuse_unread,
     start_processes,
     use_compile_cache,
@@ -234,7 +236,7 @@ def resume_configs(run_dir: str, given: dict) -> tuple[TrainConfig, list[TrainCo
             TrainConfig.from_json({**m, **given, "run_dir": os.path.join(run_dir, m["run_dir"])})
             for m in saved["members"]
         ]
-    except (OSError, json.JSONDecodeError, KeyError, TypeError) as e:
+    except (OSError, ValueError, KeyError, TypeError) as e:  # ValueError: not UTF-8, not JSON
         why = f" that can be read ({e.strerror})" if isinstance(e, OSError) and e.errno != errno.ENOENT else ""
         raise InvalidConfig("resume", run_dir, f"a sweep directory holding its {run_files.SWEEP}{why}") from None
     return base, lanes
@@ -288,6 +290,7 @@ def main(argv: list[str] | None = None) -> int:
         cfg.check_env(env)
         with recording(ns.tensorboard, per_member=True) as on_record:
             loop.run(cfg, env, members=lanes, resume=bool(ns.resume), quiet=ns.quiet, on_record=on_record)
+        interrupts_now(f"after the sweep completed ({cfg.run_dir} is whole; --resume {cfg.run_dir} draws its figure)")
     except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 2
@@ -298,10 +301,10 @@ def main(argv: list[str] | None = None) -> int:
         return 3
     if not ns.no_plot and multihost.is_first():
         out = os.path.join(cfg.run_dir, "grid.png")
-        plot.main([m.run_dir for m in lanes] + ["--group", "--out", out])
+        plot.main([m.run_dir for m in lanes] + ["--group", "--out", out, "--overwrite"])  # its own, redrawn
         progress.show(f"figure: {out}", ns.quiet)
     return 0
 
 
 if __name__ == "__main__":
-    exit_with(main())
+    exit_with(run_main(main))

@@ -1,15 +1,16 @@
 """``python -m splid_jax.train --env ENV``: train one run through the host loop (``splid_jax.runtime.loop``).
 
 Exit codes: 0 done (or already complete), 2 a mistake in the command line (one line naming the
-field, nothing written), 3 stopped (NaN, unreadable checkpoint), 130 Ctrl-C, 143 SIGTERM; a stop
-by signal keeps the newest whole state as a checkpoint to --resume from."""
+field, nothing written), 3 stopped (NaN, unreadable checkpoint, a full or read-only disk), 130 Ctrl-C,
+143 SIGTERM; a stop by signal keeps the newest whole state as a checkpoint to --resume from."""
 
 from __future__ import annotations
 
-from splid_jax.cli import exit_with, quiet_interrupts
+from splid_jax.cli import check_environment, exit_with, quiet_interrupts, run_main
 
 if __name__ == "__main__":  # a signal while JAX loads ends the process with one line, no traceback
     quiet_interrupts()
+    check_environment()
 
 import argparse  # noqa: E402
 import dataclasses  # noqa: E402
@@ -24,6 +25,7 @@ from splid_jax.cli import (  # noqa: E402
     add_config_flags,
     add_launch_flags,
     explicit_values,
+    interrupts_now,
     refuse_unread,
     start_processes,
     use_compile_cache,
@@ -59,7 +61,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog="python -m splid_jax.train",
         description="Train a goal-conditioned policy: SPLID (explore, SELECT by first hit time, behaviour "
         "cloning) or a baseline of the paper's comparison (--algo).",
-        epilog="Exit codes: 0 done, 2 bad input (nothing written), 3 stopped on NaN or an unreadable checkpoint, "
+        epilog="Exit codes: 0 done, 2 bad input (nothing written), 3 stopped on NaN, an unreadable checkpoint or a "
+        "disk refusing a write (the last whole checkpoint kept), "
         "130 Ctrl-C, 143 SIGTERM (both keep the newest whole state as a checkpoint for --resume).",
     )
     add_config_flags(parser, TrainConfig, TASK_DEFAULTS, per_algo=registry.task_defaults())
@@ -100,7 +103,7 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
         with open(path) as fh:
             saved = json.load(fh)
         unknown = sorted(set(saved) - names - set(PROVENANCE)) if isinstance(saved, dict) else ["(not an object)"]
-    except (OSError, json.JSONDecodeError):
+    except (OSError, ValueError):  # unreadable, not UTF-8, not JSON
         unknown = ["(not JSON)"]
     if unknown:
         raise InvalidConfig("resume", ns.resume, f"a run whose config.json this version wrote (it has {unknown[0]})")
@@ -121,6 +124,7 @@ def main(argv: list[str] | None = None) -> int:
         env = cfg.make_env()
         cfg.check_env(env)
         rec = run(cfg, env, resume=resume, quiet=ns.quiet, tensorboard=ns.tensorboard)
+        interrupts_now(f"after the run completed ({cfg.run_dir} is whole)")
     except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 2
@@ -139,4 +143,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    exit_with(main())
+    exit_with(run_main(main))

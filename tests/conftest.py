@@ -79,6 +79,7 @@ UNIT_SECONDS = {
     "tests/splid_jax/test_sweep.py": 31,
     "tests/splid_jax/learners/splid/test_trainer.py": 29,
     "tests/envs/test_reacher.py": 29,
+    "tests/splid_jax/runtime/test_run_files.py": 25,
     "tests/splid_jax/test_figures.py": 22,
     "tests/splid_jax/learners/test_gcsl.py": 15,
     "tests/envs/test_base.py": 15,

@@ -3,6 +3,7 @@ permission is no missing file), and which directories making one would create.""
 
 from __future__ import annotations
 
+import contextlib
 import os
 
 
@@ -18,6 +19,16 @@ def unreadable(path: str) -> str | None:
     return None if os.access(path, want) else "Permission denied"
 
 
+def is_utf8(path: str) -> bool:
+    """Whether ``path`` is UTF-8 text: a name with other bytes (``\\xff``) cannot reach orbax's and
+    TensorStore's C++ code, which takes UTF-8 strings."""
+    try:
+        path.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
 def missing_parents(path: str) -> list[str]:
     """The directories ``os.makedirs(path)`` would create, deepest first: what to remove again when
     the work they were made for does not happen."""
@@ -26,3 +37,23 @@ def missing_parents(path: str) -> list[str]:
         made.append(path)
         path = os.path.dirname(path)
     return made
+
+
+def unwritable(path: str) -> str | None:
+    """Why files cannot be written in directory ``path`` (made for the probe if missing, then removed
+    again), or None: a read-only filesystem, /proc or a regular file fails here, before any work."""
+    made = missing_parents(path)
+    try:
+        for d in reversed(made):
+            os.mkdir(d)
+        probe = os.path.join(path, f".write-test-{os.getpid()}")
+        with open(probe, "w") as fh:
+            fh.write("x")
+        os.remove(probe)
+    except OSError as e:
+        return e.strerror or str(e)
+    finally:
+        for d in made:
+            with contextlib.suppress(OSError):
+                os.rmdir(d)
+    return None

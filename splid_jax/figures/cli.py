@@ -12,7 +12,7 @@ import sys
 from collections.abc import Sequence
 
 import envs
-from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache
+from splid_jax.cli import Parser, add_compile_cache_flag, interrupts_now, use_compile_cache
 from splid_jax.common.errors import InvalidConfig, check
 from splid_jax.figures.drawing import render
 from splid_jax.figures.merging import merge
@@ -45,8 +45,8 @@ subsets, each in its own --out, and joined with --merge (figN --merge DIR1 DIR2 
 fig3 --side-by-side trains its methods at once, one process each: on a GPU under CUDA MPS
 (nvidia-cuda-mps-control -d) they share it, where in turn their times add up; on several GPUs each
 process takes one, the heaviest first, and HER's and SPLID's seeds are split while GPUs are to spare.
-Exit codes: 0 done, 2 bad input (nothing trained), 3 a run stopped (NaN), 130 Ctrl-C, 143 SIGTERM
-(each method's newest state is kept; --resume continues)."""
+Exit codes: 0 done, 2 bad input (nothing trained), 3 a run stopped (NaN, a full or read-only disk), 130 Ctrl-C,
+143 SIGTERM (each method's newest state is kept; --resume continues)."""
 
 
 def build_parser() -> Parser:
@@ -159,6 +159,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             else:
                 record = new_record(ns, spec, env_name, out, today, argv)
                 (train_side_by_side if side else train)(out, record, ns.quiet)
+            interrupts_now(f"after training ({out} is whole; --replot draws its figure)")
             png, table = render(out, ns.quiet)
     except InvalidConfig as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
@@ -169,10 +170,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (loop.RunStopped, checkpoint.CheckpointError) as err:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 3
-    except OSError as err:  # a file of the figure's own (figure.json, the PNG) on a full disk
-        if not checkpoint.is_no_space(err):
+    except OSError as err:  # a file of the figure's own (figure.json, the PNG) on a full or read-only disk
+        failure = checkpoint.write_failure(err)
+        if failure is None:
             raise
-        print(f"{parser.prog}: error: no space left on the device ({err.filename or out})", file=sys.stderr)
+        why = "no space left on the device" if checkpoint.is_no_space(err) else f"cannot write {out}: {failure[1]}"
+        print(f"{parser.prog}: error: {why} ({err.filename or out})", file=sys.stderr)
         return 3
     progress.show(f"figure: {png}\ntable: {table}", ns.quiet)
     return 0

@@ -7,6 +7,7 @@ import json
 import os
 
 from splid_jax.common.errors import InvalidConfig, check
+from splid_jax.common.paths import is_utf8
 from splid_jax.figures.registry import SPECS
 from splid_jax.runtime import lock, loop
 
@@ -22,8 +23,8 @@ def load_record(out: str, field: str = "out") -> dict:
         check(isinstance(record, dict) and record.get("figure") in SPECS, field, out,
               f"a figure directory ({path} names no figure)")  # fmt: skip
         return record
-    except (OSError, json.JSONDecodeError) as e:
-        why = "" if isinstance(e, FileNotFoundError | json.JSONDecodeError) else f" ({e.strerror})"
+    except (OSError, ValueError) as e:  # absent, unreadable, not UTF-8 or not JSON
+        why = "" if isinstance(e, FileNotFoundError | ValueError) else f" ({e.strerror})"
         raise InvalidConfig(field, out, f"a directory holding the {SPEC} a figure command wrote{why}") from None
 
 
@@ -40,7 +41,9 @@ def sweeps(record: dict) -> list[tuple[str, dict, str]]:
 
 
 def check_out(out: str) -> None:
+    check(is_utf8(out), "out", out, "a path of UTF-8 text (checkpoints are written under it)")
     if os.path.isdir(out) and set(os.listdir(out)) - {lock.LOCK}:
-        raise InvalidConfig("out", out, "a new or empty directory (--replot redraws the figure in it)")
+        why = "a new or empty directory (--resume continues the figure in it, --replot redraws it)"
+        raise InvalidConfig("out", out, why)
     check(not os.path.exists(out) or os.path.isdir(out), "out", out, "a directory, not a file")
     loop.check_writable(out)

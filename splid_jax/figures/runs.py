@@ -7,7 +7,7 @@ import time
 
 from splid_jax.config import TrainConfig
 from splid_jax.figures.record import SPEC, sweeps
-from splid_jax.runtime import checkpoint, loop, progress
+from splid_jax.runtime import loop, progress, run_files
 
 
 def train(out: str, record: dict, quiet: bool, resume: bool = False) -> None:
@@ -28,7 +28,7 @@ def train_sweep(out: str, record: dict, method: str, ran: dict, sub: str, quiet:
     run_dir = os.path.join(out, sub)
     base = TrainConfig.from_json({**ran["config"], "run_dir": run_dir})
     lanes = [TrainConfig.from_json({**m, "run_dir": os.path.join(run_dir, m["run_dir"])}) for m in ran["members"]]
-    again = resume and os.path.isdir(run_dir) and checkpoint.latest_step(run_dir) is not None
+    again = resume and run_files.holds_run(run_dir)  # started: from its checkpoint, or again
     progress.show(
         f"{record['figure']} {method}: {len(lanes)} members, {base.iterations} iterations x "
         f"{ran['episodes_per_iteration']} episodes = {ran['episodes']:,} episodes "

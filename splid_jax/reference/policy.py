@@ -6,61 +6,13 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import io
-import json
 import os
 
 import numpy as np
 
 from splid_jax.reference.episodes import run_reference, summarise
 from splid_jax.reference.extra import REFERENCE_IDS, EvaluationError, import_reference, reference_id
-
-
-def sweep_member(run_dir: str) -> tuple[str, int, int] | None:
-    """(sweep directory, member index, members) when ``run_dir`` is a member of a sweep, whose
-    checkpoints the sweep directory holds, stacked over members."""
-    parent = os.path.dirname(os.path.abspath(run_dir))
-    path = os.path.join(parent, "sweep.json")
-    if not os.path.isfile(path):
-        return None
-    with open(path) as fh:
-        names = [m.get("run_dir") for m in json.load(fh).get("members", [])]
-    name = os.path.basename(os.path.abspath(run_dir))
-    return (parent, names.index(name), len(names)) if name in names else None
-
-
-def restore_sweep(directory: str, env=None, step: int | None = None):
-    """(task, algorithm, state stacked over members, step, checkpoint record) of the sweep in ``directory``,
-    laid out as the sweep's own config builds it; ``env``: the task to build the algorithm on (default: the
-    sweep's own)."""
-    import jax
-
-    from splid_jax.config import TrainConfig
-    from splid_jax.learners.registry import make_algorithm
-    from splid_jax.runtime import checkpoint
-
-    with open(os.path.join(directory, "sweep.json")) as fh:
-        saved = json.load(fh)
-    cfg = TrainConfig.from_json(saved["config"], run_dir=directory)
-    env = cfg.make_env() if env is None else env
-    trainer = make_algorithm(cfg, env)
-    members = len(saved.get("members", []))
-    like = jax.eval_shape(jax.vmap(trainer.init), jax.random.split(jax.random.PRNGKey(0), members))
-    step, state, meta = checkpoint.restore(directory, like, step=step)
-    return env, trainer, state, step, meta
-
-
-def _restore_member(cfg, sweep: tuple[str, int, int], step: int | None):
-    """A sweep member's task, algorithm, state and step, sliced out of the sweep's stacked checkpoint
-    (members differ only in data, not in shapes)."""
-    import jax
-
-    from splid_jax.runtime.run_files import note_task_changes
-
-    directory, index, _ = sweep
-    env = cfg.make_env()  # the member's task, with any changed fields
-    env, trainer, state, step, meta = restore_sweep(directory, env, step)
-    note_task_changes(cfg.run_dir, meta.get("env", {}), env)
-    return env, trainer, jax.tree.map(lambda x: x[index], state), step
+from splid_jax.rollout import sweep_member  # noqa: F401  (named in the package's index)
 
 
 def restore_run(run_dir: str, step: int | None = None, cfg=None):
@@ -68,21 +20,13 @@ def restore_run(run_dir: str, step: int | None = None, cfg=None):
     (default: the newest): a run of train, or a member of a sweep, of any task. ``cfg``: the run's config
     as the caller changed it (default: its config.json)."""
     from splid_jax.common.networks import PolicyState
-    from splid_jax.rollout import load_config, load_policy
-    from splid_jax.runtime import checkpoint
+    from splid_jax.rollout import load_config, load_trained
 
     if not os.path.isdir(run_dir):
         raise EvaluationError(f"{run_dir} is not a directory")
     cfg = load_config(run_dir) if cfg is None else cfg
-    own = checkpoint.latest_step(run_dir) is not None
-    sweep = None if own else sweep_member(run_dir)
-    if not own and (sweep is None or checkpoint.latest_step(sweep[0]) is None):
-        raise EvaluationError(f"{run_dir} holds no checkpoint (train writes them in {run_dir}/checkpoints)")
     with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on import
-        if sweep is None:
-            env, trainer, state, step = load_policy(cfg, step)
-        else:
-            env, trainer, state, step = _restore_member(cfg, sweep, step)
+        env, trainer, state, step = load_trained(cfg, step)
     if not isinstance(getattr(state, "policy", None), PolicyState):
         raise EvaluationError(f"the checkpoint of {run_dir} holds no policy (no networks.PolicyState at .policy)")
     return cfg, env, trainer, state, step

@@ -11,7 +11,11 @@ from __future__ import annotations
 
 import errno
 import json
+import logging
 import math
+import os
+import re
+import sys
 import zlib
 from collections.abc import Mapping
 from pathlib import Path
@@ -35,14 +39,59 @@ class NoSpace(CheckpointError):
     """The disk filled up while the run wrote; its last whole checkpoint is kept."""
 
 
-def is_no_space(e: BaseException | None) -> bool:
-    """Whether ``e``, or an error it was raised from, is a full disk (orbax and tensorstore wrap it)."""
+class WriteFailed(CheckpointError):
+    """A write into the run directory failed (read-only, no permission); its last whole checkpoint is kept."""
+
+
+# What a write into the run directory may fail with, besides a full disk, that the user must fix.
+WRITE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM, errno.EIO})
+_OS_ERROR_CODE = re.compile(r"os_error_code='?(\d+)")  # how tensorstore names the errno in its messages
+
+
+def write_failure(e: BaseException | None) -> tuple[int, str] | None:
+    """``(errno, reason)`` where ``e``, or an error it was raised from, is a filesystem refusing a write
+    (orbax and tensorstore wrap it); None for any other error."""
     seen = 0
     while e is not None and seen < 20:
-        if (isinstance(e, OSError) and e.errno == errno.ENOSPC) or "No space left on device" in str(e):
-            return True
+        if isinstance(e, OSError) and e.errno in WRITE_ERRNOS:
+            return e.errno, e.strerror + (f": {e.filename}" if e.filename else "")
+        found = _OS_ERROR_CODE.search(str(e))
+        if found and int(found.group(1)) in WRITE_ERRNOS:
+            return int(found.group(1)), os.strerror(int(found.group(1)))
+        if "No space left on device" in str(e):
+            return errno.ENOSPC, os.strerror(errno.ENOSPC)
         e, seen = e.__cause__ or e.__context__, seen + 1
-    return False
+    return None
+
+
+def is_no_space(e: BaseException | None) -> bool:
+    """Whether ``e``, or an error it was raised from, is a full disk (orbax and tensorstore wrap it)."""
+    failure = write_failure(e)
+    return failure is not None and failure[0] in (errno.ENOSPC, errno.EDQUOT)
+
+
+class _OrbaxThreadErrors(logging.Filter):
+    """Drops orbax's log of an error in one of its writer threads, with its traceback: the same error
+    reaches ``save``'s caller, which reports it in one line."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not (record.exc_info and "orbax" in record.pathname)
+
+
+def quiet_closed_loops(hook):
+    """``sys.unraisablehook`` less tensorstore's callbacks into the event loop of an orbax write that
+    failed and closed it (one traceback each, from its own threads): the failure itself is reported."""
+
+    def unraisablehook(unraisable):
+        value = unraisable.exc_value
+        if not (isinstance(value, RuntimeError) and str(value) == "Event loop is closed"):
+            hook(unraisable)
+
+    return unraisablehook
+
+
+logging.getLogger("absl").addFilter(_OrbaxThreadErrors())
+sys.unraisablehook = quiet_closed_loops(sys.unraisablehook)
 
 
 def checkpoint_dir(run_dir: str | Path) -> Path:
@@ -211,6 +260,10 @@ def _restore_target(like_state: Any) -> Any:
     return jax.tree.map(target, like_state)
 
 
+class Rotated(CheckpointError):
+    """The checkpoint being read was removed meanwhile: the run writing it kept newer ones instead."""
+
+
 def restore(
     run_dir: str | Path,
     like_state: Any,
@@ -221,8 +274,24 @@ def restore(
 
     ``like_state`` may be concrete or abstract (``jax.eval_shape``). Returns ``(step, state, meta)``.
     ``expect_meta`` must match the saved meta (its keys; the saved meta may hold more).
-    Every failure is a one-line ``CheckpointError`` so the trainer can print it and stop.
+    Every failure is a one-line ``CheckpointError`` so the trainer can print it and stop. The newest
+    checkpoint of a run still training may be rotated out while it is read: the then newest is read.
     """
+    last = MAX_TO_KEEP + 1
+    for attempt in range(last + 1):
+        try:
+            return _restore(run_dir, like_state, expect_meta, step)
+        except Rotated:
+            if step is not None or attempt == last:
+                raise
+        except FileNotFoundError as e:  # a step removed while orbax listed the steps
+            if step is not None or attempt == last:
+                why = f"the checkpoints in {checkpoint_dir(run_dir)} changed while read ({_one_line(e)})"
+                raise Rotated(why) from e
+    raise AssertionError("unreachable")
+
+
+def _restore(run_dir, like_state, expect_meta, step) -> tuple[int, Any, dict[str, Any]]:
     directory = checkpoint_dir(run_dir)
     if not directory.is_dir():
         raise CheckpointError(f"no checkpoint in {directory}: directory does not exist")
@@ -239,6 +308,8 @@ def restore(
         others = [s for s in steps if s != step]
 
         def corrupt(reason: BaseException | str) -> CheckpointError:
+            if not (directory / str(step)).is_dir():
+                return Rotated(f"{where} was removed while it was read (the run writing it rotated it out)")
             reason = _one_line(reason) if isinstance(reason, BaseException) else reason
             hint = f"; other steps: {others}" if others else ""
             return CheckpointError(f"{where} is corrupt or unreadable ({reason}){hint}")

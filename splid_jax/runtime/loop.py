@@ -210,7 +210,7 @@ class _Loop:
                 lambda: [(read_metrics(os.path.join(m.run_dir, METRICS)) or [{}])[-1] for m in self.lanes]
             )
         if resume and step is None:
-            self.show(f"{cfg.run_dir}: stopped before its first checkpoint; starting it again")
+            self.show(f"{cfg.run_dir}: stopped before its first checkpoint; starting it again, its records dropped")
             resume = False
         multihost.from_first(lambda: check_writable(cfg.run_dir))
         self.saved_at = step
@@ -221,11 +221,14 @@ class _Loop:
                 kept = "nothing saved" if step is None else f"the checkpoint at iteration {step} is kept"
                 self.show(f"interrupted ({signal.Signals(stop.signum).name}) before the first chunk ended: {kept}")
             raise
-        except Exception as e:  # a full disk, whichever write met it: one line, the last checkpoint kept
-            if not checkpoint.is_no_space(e):
+        except Exception as e:  # a full disk or a refused write, whichever met it: one line, the last checkpoint kept
+            failure = checkpoint.write_failure(e)
+            if failure is None:
                 raise
             kept = "nothing saved" if self.saved_at is None else f"the checkpoint at iteration {self.saved_at} is kept"
-            raise checkpoint.NoSpace(f"no space left on the device writing {cfg.run_dir}: {kept}") from None
+            if checkpoint.is_no_space(e):
+                raise checkpoint.NoSpace(f"no space left on the device writing {cfg.run_dir}: {kept}") from None
+            raise checkpoint.WriteFailed(f"cannot write {cfg.run_dir} ({failure[1]}): {kept}") from None
 
     def start(self, resume: bool, step: int | None) -> list[dict]:
         cfg, algo = self.cfg, self.algo

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import sys
@@ -56,26 +57,49 @@ def sweep_line(recs: list[dict], total_iterations: int) -> str:
 
 
 def show(text: str, quiet: bool = False) -> None:
-    if not quiet:
+    """``text`` on stdout; once stdout is closed (``| head``) the display goes quiet and the work goes on."""
+    if quiet:
+        return
+    try:
         print(text, file=sys.stdout, flush=True)
+    except BrokenPipeError:
+        quiet_stdout()
+
+
+def quiet_stdout() -> None:
+    """stdout's descriptor pointed at /dev/null: what is still buffered, and any later print, goes
+    nowhere instead of raising again (at exit too)."""
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
 
 
 def read_metrics(path: str, error: type[Exception]) -> list[dict]:
     """The records of a metrics.jsonl; a torn last line (the writer was killed mid-line) is dropped,
-    any other bad line raises ``error`` naming the file and line."""
+    any other bad line, or bytes that are not UTF-8, raises ``error`` naming the file and line."""
     if not os.path.exists(path):
         return []
-    with open(path) as fh:
-        text = fh.read()
-    lines = text.splitlines()
+    with open(path, "rb") as fh:
+        data = fh.read()
+    lines = data.split(b"\n")
+    if lines and lines[-1] == b"":
+        lines.pop()
     records = []
-    for n, line in enumerate(lines, 1):
-        if not line.strip():
-            continue
+    for n, raw in enumerate(lines, 1):
+        torn = n == len(lines) and not data.endswith(b"\n")
         try:
-            records.append(json.loads(line))
-        except json.JSONDecodeError as e:
-            if n == len(lines) and not text.endswith("\n"):
+            record = json.loads(raw.decode())
+        except (UnicodeDecodeError, json.JSONDecodeError) as e:
+            if not raw.strip():
+                continue
+            if torn:
                 break
-            raise error(f"{path}:{n}: not a JSON record ({e.msg})") from e
+            why = "not UTF-8 text" if isinstance(e, UnicodeDecodeError) else f"not a JSON record ({e.msg})"
+            raise error(f"{path}:{n}: {why}") from None
+        if not isinstance(record, dict) or not isinstance(record.get("iteration", 0), int):
+            if torn:
+                break
+            raise error(f"{path}:{n}: not a metrics record (a JSON object with an integer iteration)")
+        records.append(record)
     return records

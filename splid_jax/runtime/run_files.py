@@ -3,7 +3,6 @@ the checks that keep one run from overwriting another."""
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import json
 import os
@@ -11,7 +10,7 @@ import sys
 
 import envs
 from splid_jax.common.errors import InvalidConfig
-from splid_jax.common.paths import missing_parents
+from splid_jax.common.paths import unwritable
 from splid_jax.config import TrainConfig
 from splid_jax.runtime import checkpoint, progress
 
@@ -89,46 +88,58 @@ def recorded(run_dir: str) -> str | None:
     return None
 
 
+def holds_run(run_dir: str) -> bool:
+    """Whether ``run_dir`` holds a run that ``--resume`` continues: a checkpoint, or the config.json or
+    sweep.json written before its first chunk (then it starts again)."""
+    if not os.path.isdir(run_dir):
+        return False
+    if any(os.path.isfile(os.path.join(run_dir, f)) for f in ("config.json", SWEEP)):
+        return True
+    return checkpoint.latest_step(run_dir) is not None
+
+
+def enclosing_run(path: str) -> str | None:
+    """The nearest directory above ``path`` that holds a run or a sweep (its config.json beside its
+    metrics or checkpoints, or a sweep.json), or None: a run made in another's directory goes with it
+    when that one rotates a checkpoint out or is deleted."""
+    here = os.path.dirname(os.path.abspath(path))
+    while True:
+        marks = [os.path.exists(os.path.join(here, f)) for f in ("config.json", METRICS, "checkpoints", SWEEP)]
+        if (marks[0] and (marks[1] or marks[2])) or marks[3]:
+            return here
+        parent = os.path.dirname(here)
+        if parent == here:
+            return None
+        here = parent
+
+
 def check_run_dir(cfg: TrainConfig, resume: bool) -> int | None:
     """Refuses a run that would overwrite another, or a resume to fewer iterations than done;
-    returns the step a resume starts from, None where the run stopped before its first checkpoint
-    and recorded nothing (it then starts again)."""
+    returns the step a resume starts from, None where the run stopped before its first whole
+    checkpoint (it then starts again, its records dropped)."""
     if not resume:
+        outer = enclosing_run(cfg.run_dir)
+        if outer is not None:
+            raise InvalidConfig("run_dir", cfg.run_dir, f"a directory outside any other run (it lies in {outer})")
+        hint = f"; to continue that run: --resume {cfg.run_dir}"
         if os.path.isdir(cfg.run_dir) and checkpoint.latest_step(cfg.run_dir) is not None:
-            raise InvalidConfig("run_dir", cfg.run_dir, "a directory without a run in it (or pass --resume RUN_DIR)")
+            why = f"a directory without a run in it (it holds a checkpoint{hint})"
+            raise InvalidConfig("run_dir", cfg.run_dir, why)
         held = holds_metrics(cfg.run_dir)
         if held is not None:
-            raise InvalidConfig("run_dir", cfg.run_dir, f"a directory without a run in it (it holds {held})")
+            hint = hint if holds_run(cfg.run_dir) else ""
+            raise InvalidConfig("run_dir", cfg.run_dir, f"a directory without a run in it (it holds {held}{hint})")
         return None
-    step = checkpoint.latest_step(cfg.run_dir) if os.path.isdir(cfg.run_dir) else None
-    if step is None and not os.path.isfile(os.path.join(cfg.run_dir, "config.json")) and not os.path.isfile(
-        os.path.join(cfg.run_dir, SWEEP)
-    ):
-        raise InvalidConfig("resume", cfg.run_dir, "a run directory holding a checkpoint")
-    if step is None:  # stopped before its first save (killed, or a save not waited for): nothing to keep
-        held = recorded(cfg.run_dir)
-        if held is not None:
-            raise InvalidConfig("resume", cfg.run_dir, f"a run directory holding a checkpoint (it holds {held})")
-        return None
-    if step > cfg.iterations:
+    if not holds_run(cfg.run_dir):
+        raise InvalidConfig("resume", cfg.run_dir, "a run directory holding a checkpoint or its config.json")
+    step = checkpoint.latest_step(cfg.run_dir)
+    if step is not None and step > cfg.iterations:
         raise InvalidConfig("iterations", cfg.iterations, f">= {step}, the iterations {cfg.run_dir} has completed")
     return step
 
 
 def check_writable(run_dir: str) -> None:
-    """Creates ``run_dir`` and a file in it, then removes what it made: a read-only filesystem or
-    /proc fails here, naming the directory, before any work."""
-    made = missing_parents(run_dir)
-    try:
-        for d in reversed(made):
-            os.mkdir(d)
-        probe = os.path.join(run_dir, f".write-test-{os.getpid()}")
-        with open(probe, "w") as fh:
-            fh.write("x")
-        os.remove(probe)
-    except OSError as e:
-        raise InvalidConfig("run_dir", run_dir, f"a writable directory ({e.strerror})") from None
-    finally:
-        for d in made:
-            with contextlib.suppress(OSError):
-                os.rmdir(d)
+    """A read-only filesystem or /proc fails here, naming the directory, before any work."""
+    why = unwritable(run_dir)
+    if why:
+        raise InvalidConfig("run_dir", run_dir, f"a writable directory ({why})")

@@ -5,6 +5,7 @@ import json
 
 import jax
 import numpy as np
+import pytest
 
 from envs import make as make_env
 from splid_jax import export, train
@@ -65,3 +66,44 @@ def test_an_export_is_refused_over_an_existing_directory_and_for_resume(tmp_path
     assert train.main(["--resume", str(tmp_path / "new" / "run"), "--iterations", "6"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.splitlines()[-1].endswith("(its export.json names the run)")
+
+
+def _another_export_wins(out):
+    real = checkpoint.save
+
+    def save(run_dir, *a, **kw):
+        (out / "run").mkdir(parents=True)  # the other export's rename lands first
+        (out / "run" / "config.json").write_text("{}")
+        return real(run_dir, *a, **kw)
+
+    return save
+
+
+def _disk_full(*a, **kw):
+    raise ValueError("RESOURCE_EXHAUSTED: Failed writing: No space left on device [os_error_code='28']")
+
+
+@pytest.mark.parametrize(
+    "save, code, said",
+    [(_another_export_wins, 2, "another export wrote it meanwhile"), (lambda out: _disk_full, 3, "no space left")],
+    ids=["two-exports", "full-disk"],
+)
+def test_a_failed_export_is_one_line_and_leaves_nothing_half_written(tmp_path, capsys, monkeypatch, save, code, said):
+    run, out = tmp_path / "run", tmp_path / "out"
+    _saved_run(run, hidden=(8,), buffer_size=64, batch_size=4)
+    monkeypatch.setattr(checkpoint, "save", save(out))
+    assert export.main([str(run), "--out", str(out)]) == code
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and said in err
+    assert sorted(p.name for p in out.iterdir()) == (["run"] if code == 2 else [])  # no temporary left
+    monkeypatch.undo()
+    if code == 3:  # the retry is not refused by what the failed one left
+        assert export.main([str(run), "--out", str(out)]) == 0
+
+
+@pytest.mark.parametrize("out", ["", "bad-\udcff"], ids=["empty", "not-utf8"])
+def test_an_empty_or_undecodable_out_is_refused(tmp_path, capsys, monkeypatch, out):
+    monkeypatch.chdir(tmp_path)
+    assert export.main([str(tmp_path / "run"), "--out", out]) == 2
+    assert f"invalid out={out!r}" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []

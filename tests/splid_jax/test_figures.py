@@ -124,6 +124,14 @@ def test_resume_of_a_finished_figure_trains_nothing_and_redraws_it(fig3):
     assert (out / "fig3-point.png").read_bytes()[:8] == PNG_MAGIC
 
 
+def test_an_out_that_is_not_utf8_is_one_line_and_exit_2(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert figures.main(["fig8", "--quick", "--out", "bad-\udcff"]) == 2  # a \xff byte: orbax takes UTF-8 alone
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "invalid out=" in err and "UTF-8" in err
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize(
     "args, field",
     [

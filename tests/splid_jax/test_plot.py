@@ -72,6 +72,17 @@ def test_group_and_out(tmp_path):
     assert_png(out)
 
 
+def test_an_existing_out_is_kept_unless_overwrite_is_given(tmp_path, capsys):
+    run = make_run(tmp_path, "s0", 0)
+    out = tmp_path / "mine.png"
+    out.write_bytes(b"the user's figure")
+    assert plot.main([str(run), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--overwrite" in err and out.read_bytes() == b"the user's figure"
+    assert plot.main([str(run), "--out", str(out), "--overwrite"]) == 0
+    assert_png(out)
+
+
 def test_labels_and_groups(tmp_path):
     runs = [
         plot.load_run(make_run(tmp_path, "a", 0, sigma=0.5, horizon=8)),

@@ -278,3 +278,18 @@ def test_rollout_of_an_unreadable_run_is_not_called_missing(tmp_path, capsys, mo
     assert rollout.main([str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "whose config.json can be read (Permission denied)" in err
+
+
+def test_rollout_of_a_sweep_member_rolls_its_slice_of_the_sweeps_checkpoint_out(tmp_path, capsys):
+    cfg = TrainConfig(env="point", iterations=2, eval_every=2, num_envs=4, hidden=(16,), run_dir=str(tmp_path))
+    env = cfg.make_env()
+    init = Trainer(env, cfg).init
+    stacked = jax.vmap(init)(jax.random.split(jax.random.PRNGKey(0), 2))
+    checkpoint.save(tmp_path, 2, stacked, {"env": env_settings(env)})
+    members = [{**cfg.to_json(), "seed": i, "run_dir": f"m{i}"} for i in range(2)]
+    (tmp_path / "sweep.json").write_text(json.dumps({"config": cfg.to_json(), "members": members}))
+    for m in members:
+        (tmp_path / m["run_dir"]).mkdir()
+        (tmp_path / m["run_dir"] / "config.json").write_text(json.dumps({**m, "run_dir": str(tmp_path / m["run_dir"])}))
+    assert rollout.main([str(tmp_path / "m1"), "--episodes", "2"]) == 0
+    assert "iteration 2" in capsys.readouterr().out and (tmp_path / "m1" / "rollout-2.png").is_file()

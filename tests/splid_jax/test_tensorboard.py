@@ -118,3 +118,53 @@ def test_a_missing_extra_is_one_line_before_any_work(tmp_path, monkeypatch, caps
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "tensorboardX" in err and "tensorboard" in err
     assert not (run_dir / "metrics.jsonl").exists()
+
+
+@pytest.mark.parametrize("command", ["train", "sweep"])
+@pytest.mark.parametrize("where", ["a-file", "/proc/splid-tb"])
+def test_a_tensorboard_dir_that_cannot_be_written_is_refused_before_any_work(tmp_path, capsys, command, where):
+    import importlib
+
+    (tmp_path / "a-file").write_text("x")
+    log_dir = where if where.startswith("/") else str(tmp_path / where)
+    argv = ["--env", "point", "--iterations", "5", "--run-dir", str(tmp_path / "run"), "--tensorboard", log_dir]
+    assert importlib.import_module(f"splid_jax.{command}").main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "invalid tensorboard=" in err and "writable" in err
+    assert not (tmp_path / "run").exists()
+
+
+def test_a_full_disk_fails_the_write_itself_and_the_close_after_it_is_quiet(tmp_path, monkeypatch):
+    import errno
+    import socket
+    import time
+
+    monkeypatch.setattr(time, "time", lambda: 1234567890.5)  # the event file's name, made ahead as /dev/full
+    (tmp_path / f"events.out.tfevents.1234567890.{socket.gethostname()}").symlink_to("/dev/full")
+    with pytest.raises(OSError) as failed, tensorboard.recording(str(tmp_path)) as on_record:
+        on_record(str(tmp_path / "run"), RECORDS[0])
+    assert failed.value.errno == errno.ENOSPC
+
+
+@pytest.mark.parametrize(
+    "content, said",
+    [
+        (b'{"iteration": 5, "episodes": 1}\n\xff\xfe\n', "metrics.jsonl:2: not UTF-8 text"),
+        (b'{"iteration": 5, "episodes": 1}\n[1, 2]\n', "metrics.jsonl:2: not a metrics record"),
+        (b'{"iteration": 5, "episodes": 1}\nnot json\n{"iteration": 10}\n', "metrics.jsonl:2: not a JSON record"),
+        (b'{"iteration": 5, "episodes": "many"}\n', "non-numeric episodes"),
+    ],
+)
+def test_a_garbage_metrics_line_is_one_line_naming_it(tmp_path, capsys, content, said):
+    metrics = tmp_path / "metrics.jsonl"
+    metrics.write_bytes(content)
+    assert tensorboard.main([str(metrics), str(tmp_path / "tb")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and said in err
+
+
+def test_a_torn_last_line_is_dropped(tmp_path, capsys):
+    metrics = tmp_path / "metrics.jsonl"
+    metrics.write_text(json.dumps(RECORDS[0]) + "\n" + json.dumps(RECORDS[1])[:20])
+    assert tensorboard.main([str(metrics), str(tmp_path / "tb")]) == 0
+    assert "1 records" in capsys.readouterr().out

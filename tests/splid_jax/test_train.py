@@ -80,6 +80,7 @@ def final_params(run_dir):
         (["--sigma", "nan"], "sigma"),
         (["--num-envs", "100000000"], "num_envs"),  # refused from its shapes, before anything is allocated
         (["--run-dir", ""], "run_dir"),
+        (["--run-dir", "bad-\udcff"], "run_dir"),  # a \xff byte in the name: orbax takes UTF-8 paths only
         (["--bc-steps", "0"], "bc_steps"),  # no cloning step: the loss would be undefined
         (["--gcsl-relabel", "future"], "gcsl_relabel"),  # flags the learner does not read
         (["--pchid-every", "3"], "pchid_every"),
@@ -383,23 +384,32 @@ def test_a_torn_record_at_the_checkpoint_is_warned_of(tmp_path, capsys):
     assert len(err.splitlines()) == 1 and "ends at iteration 5" in err and "6-10 are lost" in err
 
 
-def test_a_full_disk_is_one_line_exit_3_and_keeps_the_last_whole_checkpoint(tmp_path, capsys, monkeypatch):
-    import errno
-
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "error, said",
+    [
+        (OSError(28, "No space left on device"), "no space left on the device"),
+        (OSError(30, "Read-only file system", "ckpt"), "cannot write RUN (Read-only file system: ckpt)"),
+        (ValueError("PERMISSION_DENIED: Error opening file [os_error_code='13']"), "cannot write RUN (Permission"),
+    ],
+    ids=["full", "read-only", "permission"],
+)
+def test_a_failed_write_is_one_line_exit_3_and_keeps_the_last_whole_checkpoint(tmp_path, capsys, monkeypatch,
+                                                                               error, said):  # fmt: skip
     real_save, saves = checkpoint.save, []
 
-    def fills_up(run_dir, step, *a, **kw):
+    def fails(run_dir, step, *a, **kw):
         saves.append(step)
         if len(saves) > 1:
-            raise OSError(errno.ENOSPC, "No space left on device", run_dir)
+            raise error
         return real_save(run_dir, step, *a, **kw)
 
-    monkeypatch.setattr(checkpoint, "save", fills_up)
+    monkeypatch.setattr(checkpoint, "save", fails)
     run_dir = tmp_path / "run"
     args = [*TINY, "--iterations", "15", "--checkpoint-every", "1", "--run-dir", str(run_dir), "--quiet"]
     assert main(args) == 3
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "no space left" in err and "iteration 5 is kept" in err
+    assert len(err.splitlines()) == 1 and said.replace("RUN", str(run_dir)) in err and "iteration 5 is kept" in err
     assert checkpoint.latest_step(str(run_dir)) == 5
 
 

@@ -140,7 +140,9 @@ class ES(Chunked):
         )
 
     def watched(self, ts: EsState, per_gen: dict) -> tuple:
-        return ts.search.mean, jnp.isfinite(per_gen["fitness_mean"])
+        """The search mean, and per generation whether its returns were finite and any member's episodes
+        stayed valid (none did: a mean so far off that the whole population's physics went NaN)."""
+        return ts.search.mean, jnp.isfinite(per_gen["fitness_mean"]) & jnp.isfinite(per_gen["fitness_max"])
 
     @property
     def episodes_per_iteration(self) -> int:

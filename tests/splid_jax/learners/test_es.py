@@ -50,11 +50,12 @@ class Toy(ES):
 
     direction = None
     poison = False
+    diverged = False  # every member's episodes went NaN
 
     def episode_returns(self, pstate, members, key):
         flat = jax.vmap(lambda p: ravel_pytree(p)[0])(members)
         ret = flat @ self.direction if self.direction is not None else jnp.zeros(flat.shape[0])
-        invalid = (ret > 0) & self.poison
+        invalid = ((ret > 0) & self.poison) | self.diverged
         return ret, jnp.zeros_like(invalid), invalid
 
 
@@ -85,6 +86,15 @@ def test_a_member_whose_episode_went_nan_ranks_last():
     toy.poison = True  # every member with a positive return is invalid: the search must turn away
     moved = run_generations(toy, state) - mean0
     assert cosine(moved, toy.direction) < -0.5
+
+
+@pytest.mark.parametrize("diverged", [False, True])
+def test_a_generation_whose_every_member_went_nan_is_divergence(diverged):
+    toy, _, state = toy_search()
+    toy.poison, toy.diverged = True, diverged  # some members invalid, or all of them
+    _, per_gen = jax.jit(toy.generation)(state)
+    _, finite = toy.watched(state, jax.tree.map(lambda x: x[None], per_gen))
+    assert bool(finite.all()) != diverged
 
 
 def test_weight_decay_shrinks_the_parameters_when_returns_tie():

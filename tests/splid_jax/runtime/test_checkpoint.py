@@ -242,3 +242,64 @@ def test_killed_mid_save_leaves_previous_step(tmp_path):
     assert ck.save(tmp_path, 2, {"w": np.ones(100_000, dtype=np.float32)}, {"k": 1})
     assert sorted(p.name for p in ck.checkpoint_dir(tmp_path).iterdir()) == ["1", "2"]
     assert np.array_equal(ck.restore(tmp_path, like)[1]["w"], np.ones(100_000, np.float32))
+
+
+@pytest.mark.parametrize(
+    "error, found",
+    [
+        (OSError(28, "No space left on device"), (28, "No space left on device")),
+        (OSError(30, "Read-only file system", "/r/checkpoints"), (30, "Read-only file system: /r/checkpoints")),
+        (ValueError("PERMISSION_DENIED: Failed writing: x [os_error_code='13']"), (13, os.strerror(13))),
+        (ValueError("RESOURCE_EXHAUSTED: Failed to write 427 bytes: No space left on device"), (28, os.strerror(28))),
+        (FileNotFoundError(2, "No such file or directory"), None),
+        (ValueError("shape mismatch"), None),
+    ],
+)
+def test_a_refused_write_is_told_from_other_errors_through_orbaxs_wrapping(error, found):
+    wrapped = RuntimeError("orbax failed")
+    wrapped.__cause__ = error
+    assert ck.write_failure(error) == found and ck.write_failure(wrapped) == found
+    assert ck.is_no_space(wrapped) == (found is not None and found[0] == 28)
+
+
+def test_orbax_thread_tracebacks_and_closed_loop_callbacks_are_not_printed():
+    import logging
+
+    try:
+        raise ValueError("RESOURCE_EXHAUSTED")
+    except ValueError:
+        record = logging.LogRecord("absl", logging.ERROR, "/x/orbax/checkpoint/future.py", 1, "raised", (),
+                                   sys.exc_info())  # fmt: skip
+    absl = logging.getLogger("absl")
+    assert not all(f.filter(record) for f in absl.filters)
+    record.pathname = "/x/elsewhere.py"
+    assert all(f.filter(record) for f in absl.filters)
+    seen = []  # pytest replaces sys.unraisablehook while a test runs: the wrapper, wrapped around a list
+    hook = ck.quiet_closed_loops(seen.append)
+    for text in ("Event loop is closed", "another"):
+        hook(type("U", (), {"exc_value": RuntimeError(text)})())
+    assert [str(u.exc_value) for u in seen] == ["another"]
+
+
+def test_a_checkpoint_rotated_out_while_read_gives_the_then_newest(tmp_path, monkeypatch):
+    import shutil
+
+    import orbax.checkpoint as ocp
+
+    for step in (1, 2, 3):
+        ck.save(tmp_path, step, make_state(step, obs_shape=(4, 5)), META)
+    real, removed = ocp.CheckpointManager.restore, []
+
+    def rotating(self, step, *a, **kw):  # the run writing them saves 4 and drops 1..3 meanwhile
+        if not removed:
+            removed.append(step)
+            shutil.rmtree(tmp_path / "checkpoints" / str(step))
+        return real(self, step, *a, **kw)
+
+    monkeypatch.setattr(ocp.CheckpointManager, "restore", rotating)
+    step, state, _ = ck.restore(tmp_path, make_state(0, obs_shape=(4, 5)))
+    assert removed == [3] and step == 2
+    np.testing.assert_array_equal(state.buffer.obs, make_state(2, obs_shape=(4, 5)).buffer.obs)
+    removed.clear()
+    with pytest.raises(ck.Rotated, match="removed while it was read"):  # a step asked for is not replaced
+        ck.restore(tmp_path, make_state(0, obs_shape=(4, 5)), step=2)

@@ -1,0 +1,51 @@
+"""What every command shares: one line, never a traceback, for a bad environment variable and for a
+signal outside a run's own handlers (before it, after it, in a command that trains nothing). In
+subprocesses, since the variables and signals are the process's own."""
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def python(code: str, *args: str, env: dict | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, **(env or {})}, cwd=ROOT)  # fmt: skip
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("variable", ["MUJOCO_GL", "JAX_PLATFORMS"])
+def test_a_bad_environment_variable_is_one_line_naming_it(tmp_path, variable):
+    run = "import runpy; runpy.run_module('splid_jax.train', run_name='__main__', alter_sys=True)"
+    done = python(run, "--env", "point", "--run-dir", str(tmp_path / "run"), env={variable: "bogus"})
+    assert done.returncode == 2, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and f"{variable}='bogus'" in done.stderr
+    assert not (tmp_path / "run").exists()
+
+
+def test_a_signal_after_the_run_says_the_run_is_whole():
+    done = python("import os, signal, time\nfrom splid_jax import cli\ncli.quiet_interrupts()\n"
+                  "cli.interrupts_now('after the run completed (R is whole)')\n"
+                  "os.kill(os.getpid(), signal.SIGINT)\ntime.sleep(10)")  # fmt: skip
+    assert done.returncode == 130 and done.stderr == "interrupted (SIGINT) after the run completed (R is whole)\n"
+
+
+def test_a_signal_while_python_shuts_down_after_the_work_is_ignored():
+    done = python("import atexit, os, signal, time\nfrom splid_jax import cli\ncli.quiet_interrupts()\n"
+                  "atexit.register(lambda: (os.kill(os.getpid(), signal.SIGTERM), time.sleep(0.2)))\n"
+                  "cli.exit_with(0)")  # fmt: skip
+    assert done.returncode == 0 and done.stderr == ""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", ["plot", "rollout"])
+def test_ctrl_c_in_a_command_that_trains_nothing_is_one_line(tmp_path, command):
+    stops_at_parse = ("import argparse, os, runpy, signal, sys, time\n"
+                      "def parse(*a, **k):\n    os.kill(os.getpid(), signal.SIGINT)\n    time.sleep(10)\n"
+                      "argparse.ArgumentParser.parse_args = parse\n"
+                      f"runpy.run_module('splid_jax.{command}', run_name='__main__', alter_sys=True)")  # fmt: skip
+    done = python(stops_at_parse, str(tmp_path))
+    assert done.returncode == 130 and done.stderr == "interrupted (SIGINT)\n", done.stderr
