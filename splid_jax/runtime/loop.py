@@ -33,7 +33,7 @@ import envs
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 from splid_jax.learners import registry
-from splid_jax.learners.base import EVAL_KEYS, Algorithm
+from splid_jax.learners.base import Algorithm
 from splid_jax.runtime import checkpoint, devices, lock, multihost, programs, progress
 from splid_jax.runtime.groups import Groups
 from splid_jax.runtime.memory import DoesNotFit, check_memory, compile_hint, gigabytes, nbytes, sizes
@@ -44,16 +44,17 @@ from splid_jax.runtime.run_files import (
     check_writable,
     env_settings,
     identity,
+    metrics_record,
     read_metrics,
+    warn_of_gap,
     write_atomic,
     write_json,
 )
 from splid_jax.runtime.signals import Interrupted, SaveAbandoned, Signals
+from splid_jax.runtime.stalls import late_after, late_message
+from splid_jax.runtime.states import abstract, canonical, initial_state
 
 COUNTER_KEYS = ("iteration", "episodes", "env_steps", "select_steps")
-# A chunk that runs this many times longer than the slowest before it, and at least LATE_FLOOR_S,
-# is reported on stderr as a possibly stalled device (the run goes on waiting).
-LATE_FACTOR, LATE_FLOOR_S = 10.0, 60.0
 
 
 class RunStopped(RuntimeError):
@@ -86,47 +87,6 @@ def _lane_hyper(algo: Algorithm, base: TrainConfig, lane: TrainConfig) -> Any:
     return algo.hyper(lane)
 
 
-def initial_state(init: Callable[[jax.Array], Any], keys: jax.Array, stacked: bool, one_by_one: bool) -> Any:
-    """``init`` of each key, stacked along a leading axis for a sweep. ``one_by_one`` builds each member
-    alone and stacks them, for XLA:CPU: jaxlib 0.10.2 never finishes the vmapped init of five Push members
-    (each member alone, or four together, takes a second). A member's state depends on its key alone, so
-    both ways give the same arrays."""
-    if not stacked:
-        return jax.jit(init)(keys)
-    if not one_by_one:
-        return jax.jit(jax.vmap(init))(keys)
-    one = jax.jit(init)
-    return jax.tree.map(lambda *x: jnp.stack(x), *[one(k) for k in keys])
-
-
-def canonical(tree, sharding):
-    """Strongly typed arrays placed as ``sharding`` says, whether they come from init or a checkpoint,
-    so the compiled chunk takes a resumed state as it takes a fresh one."""
-    # made on one device, then placed: XLA:CPU can hang in a later program that reads an array a
-    # multi-device jit wrote through out_shardings
-    return jax.device_put(jax.jit(_strong)(tree), sharding)
-
-
-def _strong(tree):
-    return jax.tree.map(lambda x: jnp.asarray(x).astype(jnp.asarray(x).dtype), tree)
-
-
-def abstract(tree, sharding):
-    """``tree``'s shapes and dtypes placed as ``sharding`` says: what ``canonical`` makes of it, abstractly."""
-    return jax.tree.map(lambda x: jax.ShapeDtypeStruct(x.shape, x.dtype, sharding=sharding), tree)
-
-
-def _record(algo, cfg, metrics: dict, i: int | None, iteration: int, total: int, chunk: int, chunk_s, wall_s):
-    rec = algo.counters(iteration, total)
-    rec.update({k: metrics[k] if i is None else metrics[k][i] for k in EVAL_KEYS})
-    rec.update({k: v if i is None else v[i] for k, v in metrics.items() if k not in rec})
-    rec = {k: v.item() if hasattr(v, "item") else v for k, v in rec.items()}
-    steps = algo.counters(cfg.eval_every, chunk)
-    rec["steps_per_s"] = (steps["env_steps"] + steps["select_steps"]) / max(chunk_s, 1e-9)
-    rec["wall_s"] = wall_s
-    return rec
-
-
 def run(
     cfg: TrainConfig,
     env: envs.GoalEnv | None = None,
@@ -151,30 +111,6 @@ def run(
         split_envs = place.axis == devices.ENVS and place.count > 1
         algo = algo or signals.wait(lambda: registry.make_algorithm(cfg, env, place.mesh if split_envs else None))
         return _Loop(cfg, env, algo, members, place, signals, quiet, on_record).run(resume)
-
-
-def late_after(slowest_s: float) -> float | None:
-    """Seconds after which a chunk counts as late: none before one has finished, since the first
-    takes as long as it takes."""
-    return None if slowest_s <= 0 else max(LATE_FLOOR_S, LATE_FACTOR * slowest_s)
-
-
-def late_message(cfg: TrainConfig, iteration: int, ran_s: float, slowest_s: float) -> str:
-    span = f"{iteration + 1}-{iteration + cfg.eval_every}"
-    return (
-        f"{cfg.run_dir}: iterations {span} have run {ran_s:.0f} s, {ran_s / slowest_s:.0f}x the slowest chunk "
-        f"before them ({slowest_s:.1f} s); the device may be stalled (Ctrl-C saves iteration {iteration} and stops)"
-    )
-
-
-def warn_of_gap(path: str, kept: list[dict], step: int) -> None:
-    """A metrics file that stops short of its checkpoint (a torn last line, a deleted file) would
-    resume with a gap in its curve: said on stderr, since the records cannot be made again."""
-    last = kept[-1]["iteration"] if kept else 0
-    if last < step:
-        what = "is missing or empty" if not kept else f"ends at iteration {last}"
-        print(f"warning: {path} {what} but the checkpoint is at iteration {step}: the records of iterations "
-              f"{last + 1}-{step} are lost, so its curve has a gap there", file=sys.stderr)  # fmt: skip
 
 
 class _Loop:
@@ -418,7 +354,7 @@ class _Loop:
                 totals = [t + int(c) for t, c in zip(select_steps, per_lane, strict=True)]
                 now = wall()
                 last = [
-                    _record(
+                    metrics_record(
                         algo, cfg, metrics, i if self.stacked else None, done, totals[i], int(per_lane[i]), chunk_s, now
                     )  # fmt: skip
                     for i in range(len(lanes))

@@ -12,6 +12,7 @@ import envs
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.common.paths import unwritable
 from splid_jax.config import TrainConfig
+from splid_jax.learners.base import EVAL_KEYS
 from splid_jax.runtime import checkpoint, progress
 
 # Fields a resumed run must share with its checkpoint; the rest may change on resume.
@@ -44,9 +45,7 @@ def identity(cfg: TrainConfig) -> dict:
     fields = dataclasses.fields(cfg)
     later = {f.name: f.metadata.get("unrecorded", f.default) for f in fields if f.metadata.get("recorded_when_set")}
     kept = {
-        k: v
-        for k, v in cfg.to_json().items()
-        if k not in MAY_CHANGE_ON_RESUME and not (k in later and v == later[k])
+        k: v for k, v in cfg.to_json().items() if k not in MAY_CHANGE_ON_RESUME and not (k in later and v == later[k])
     }
     return json.loads(json.dumps(kept))
 
@@ -143,3 +142,26 @@ def check_writable(run_dir: str) -> None:
     why = unwritable(run_dir)
     if why:
         raise InvalidConfig("run_dir", run_dir, f"a writable directory ({why})")
+
+
+def warn_of_gap(path: str, kept: list[dict], step: int) -> None:
+    """A metrics file that stops short of its checkpoint (a torn last line, a deleted file) would
+    resume with a gap in its curve: said on stderr, since the records cannot be made again."""
+    last = kept[-1]["iteration"] if kept else 0
+    if last < step:
+        what = "is missing or empty" if not kept else f"ends at iteration {last}"
+        print(f"warning: {path} {what} but the checkpoint is at iteration {step}: the records of iterations "
+              f"{last + 1}-{step} are lost, so its curve has a gap there", file=sys.stderr)  # fmt: skip
+
+
+def metrics_record(algo, cfg, metrics: dict, i: int | None, iteration: int, total: int, chunk: int, chunk_s, wall_s):
+    """A chunk's metrics.jsonl record for lane ``i`` (None: a single run): the algorithm's counters, the
+    evaluation, its other metrics as Python scalars, the chunk's steps per second and the wall time."""
+    rec = algo.counters(iteration, total)
+    rec.update({k: metrics[k] if i is None else metrics[k][i] for k in EVAL_KEYS})
+    rec.update({k: v if i is None else v[i] for k, v in metrics.items() if k not in rec})
+    rec = {k: v.item() if hasattr(v, "item") else v for k, v in rec.items()}
+    steps = algo.counters(cfg.eval_every, chunk)
+    rec["steps_per_s"] = (steps["env_steps"] + steps["select_steps"]) / max(chunk_s, 1e-9)
+    rec["wall_s"] = wall_s
+    return rec

@@ -375,7 +375,7 @@ def test_an_unreadable_run_is_not_called_missing(tmp_path, capsys, monkeypatch):
 
 
 def test_a_torn_record_at_the_checkpoint_is_warned_of(tmp_path, capsys):
-    from splid_jax.runtime.loop import warn_of_gap
+    from splid_jax.runtime.run_files import warn_of_gap
 
     warn_of_gap("m.jsonl", [{"iteration": 5}, {"iteration": 10}], 10)
     assert capsys.readouterr().err == ""
