@@ -255,18 +255,19 @@ def test_targets_move_every_target_every_steps_only_once_warm():
         ) == moves
 
 
-def test_the_mrl_preset_learns_the_point_task_and_not_without_its_updates():
+def test_the_mrl_preset_learns_the_point_task_within_400_episodes():
     """mrl's settings scaled to the CPU (narrower nets, smaller batches, a step per 8 transitions, warm-ups
-    shortened in proportion); with no gradient step the policy stays at its initial one."""
+    shortened in proportion). Without its gradient steps the policy would stay at its initial one, which rarely
+    reaches the goal."""
     small = dict(hidden=(64, 64), batch_size=256, buffer_transitions=100_000, update_every=8)
     small.update(random_transitions=2_000, warm_up=1_000, actual_warm_up=5_000)
-    cfg = TrainConfig(**{**CFG, "num_envs": 8, "iterations": 100, "eval_every": 25})
-    baseline = random_policy_success(envs.make("point"))
-    for update_every, learns in ((8, True), (10**6, False)):
-        her = HER(envs.make("point"), cfg, HerConfig(**{**small, "update_every": update_every}))
-        state, metrics = her.init(jax.random.PRNGKey(0)), None
-        chunk = jax.jit(her.chunk)
-        for _ in range(4):
-            state, metrics = chunk(state, her.hyper())
-        success = float(metrics["eval_success_final"])
-        assert (success > baseline + 0.25) == learns, (success, baseline, update_every)
+    cfg = TrainConfig(**{**CFG, "num_envs": 8, "iterations": 50, "eval_every": 25})
+    her = HER(envs.make("point"), cfg, HerConfig(**small))
+    assert her.n_updates == 50
+    state, chunk = her.init(jax.random.PRNGKey(0)), jax.jit(her.chunk)
+    for _ in range(2):
+        state, metrics = chunk(state, her.hyper())
+    baseline = random_policy_success(her.env)
+    # seed 0 reaches 0.77 against a random policy's 0.20
+    assert float(metrics["eval_success_final"]) > baseline + 0.3, (metrics, baseline)
+    assert float(metrics["critic_loss"]) > 0 and int(metrics["buffer_size"]) == 400
