@@ -9,6 +9,7 @@ import argparse
 import contextlib
 import dataclasses
 import os
+import re
 import signal
 import sys
 
@@ -88,7 +89,7 @@ class Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
     def format_help(self) -> str:
-        listings = {"env_options": task_fields, **learner_option_fields()}
+        listings = {"env_options": task_fields}
         for action in self._actions:
             if action.dest in listings and not getattr(action, "fields_listed", False):
                 action.help = f"{action.help}. Fields and defaults: {listings[action.dest]()}".replace("%", "%%")
@@ -96,14 +97,27 @@ class Parser(argparse.ArgumentParser):
         return super().format_help()
 
 
-def learner_option_fields() -> dict:
-    """For each learner whose settings travel as KEY=VALUE text (``--her-options``), its fields and defaults."""
-    from splid_jax.common.values import option_fields
-    from splid_jax.learners import registry
+def flag_error(err, parser: argparse.ArgumentParser) -> str:
+    """An ``InvalidConfig`` as the user typed it: ``invalid --iterations 3: must be a multiple of
+    --eval-every 5``. Settings that are no flag of ``parser`` keep their own names."""
+    flags = {option for action in parser._actions for option in action.option_strings}
 
-    return {
-        x.options: lambda x=x: option_fields(x.settings) for x in registry.LEARNERS.values() if x.options is not None
-    }
+    def flag(name: str) -> str | None:
+        typed = "--" + name.replace(".", "-").replace("_", "-")
+        return typed if typed in flags else None
+
+    def named(match: re.Match) -> str:
+        return f"{flag(match[1])} {match[2]}" if flag(match[1]) else match[0]
+
+    def typed(text: str) -> str:
+        text = re.sub(r"\b([a-z][a-z0-9]*(?:[._][a-z0-9]+)*)=([^\s,;()]+)", named, text)
+        return re.sub(r"\b[a-z][a-z0-9]*(?:_[a-z0-9]+)+\b", lambda m: flag(m[0]) or m[0], text)
+
+    if str(err) != f"invalid {err.field}={err.value!r}: must be {err.allowed}":  # a message of its own
+        return typed(str(err))
+    value = ",".join(map(str, err.value)) if isinstance(err.value, tuple | list) else err.value
+    head = f"{flag(err.field)} {value}" if flag(err.field) else f"{err.field}={err.value!r}"
+    return f"invalid {head}: must be {typed(err.allowed)}"
 
 
 def readers(name: str) -> str | None:
@@ -201,9 +215,36 @@ def _show(value) -> str:
     return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
 
 
+def add_learner_flags(parser: argparse.ArgumentParser) -> None:
+    """One flag per field of each learner's own settings dataclass (``--her-batch-size``), in that learner's
+    group; ``explicit_values`` gathers them into the learner's options text (``her_options``)."""
+    from splid_jax.learners import registry
+
+    for learner in registry.LEARNERS.values():
+        if learner.options is None:
+            continue
+        group = parser.add_argument_group(f"{learner.name}'s own settings (read only by {learner.name})")
+        prefix = learner.options.removesuffix("_options")
+        for f in dataclasses.fields(learner.settings):
+            flag, dest = f"--{prefix}-{f.name.replace('_', '-')}", f"{learner.options}:{f.name}"
+            help_text = f"{f.metadata.get('help', '')} (default: {_show(f.default)})".replace("%", "%%")
+            if f.type == "bool":
+                group.add_argument(flag, dest=dest, action=argparse.BooleanOptionalAction, help=help_text)
+            else:
+                group.add_argument(flag, dest=dest, type=_TYPES[f.type], help=help_text, metavar=f.name.upper())
+
+
 def explicit_values(cls, namespace: argparse.Namespace) -> dict:
+    """The settings given on the command line; a learner's own flags (``add_learner_flags``) join its
+    options text, after those ``--her-options`` gives."""
     names = {f.name for f in dataclasses.fields(cls)}
-    return {k: v for k, v in vars(namespace).items() if k in names and v is not None}
+    given = {k: v for k, v in vars(namespace).items() if k in names and v is not None}
+    for key, value in vars(namespace).items():
+        options, _, name = key.partition(":")
+        if name and value is not None and options in names:
+            shown = str(value).lower() if isinstance(value, bool) else _show(value)
+            given[options] = ",".join(filter(None, (given.get(options), f"{name}={shown}")))
+    return given
 
 
 def default_compile_cache() -> str:

@@ -14,10 +14,11 @@ import os
 from typing import Any
 
 import envs
+from splid_jax import presets
 from splid_jax.common.errors import check
 from splid_jax.common.fields import field
 from splid_jax.common.paths import is_utf8
-from splid_jax.common.values import format_overrides, options_text, parse_options, parse_overrides
+from splid_jax.common.values import format_overrides, merged_options, options_text, parse_options, parse_overrides
 from splid_jax.learners import registry
 
 MAX_ITERATIONS = 10**7  # far beyond any run's budget: a larger value is a typo, and would run for ever
@@ -25,6 +26,9 @@ MAX_ITERATIONS = 10**7  # far beyond any run's budget: a larger value is a typo,
 # are read against (HER's defaults were Baselines' before they became mrl's).
 PROVENANCE = ("devices", "her_defaults")
 HER_DEFAULTS = "mrl"
+# Settings runs were once recorded with that left the package (experiments/NOTES.md, "Retired options"): a
+# config.json holding one at its neutral value loads without it, one at another value is refused
+RETIRED = {"hold_horizon": 0, "rest_horizon": 0, "select_radius": 1.0, "held_share": 0.0}
 
 
 _KINDS = {
@@ -55,6 +59,11 @@ def _is_a(value: Any, kind: str) -> bool:
 @dataclasses.dataclass(frozen=True)
 class TrainConfig:
     env: str = field("point", "task: " + ", ".join(envs.names()))
+    preset: str = field(
+        "tuned",
+        "the defaults the other settings start from: " + "; ".join(f"{k} ({v})" for k, v in presets.PRESETS.items()),
+        recorded_when_set=True,
+    )
     seed: int = field(
         0,
         "PRNG seed; the same seed gives the same run from the same compiled program (the compile cache keeps "
@@ -99,33 +108,13 @@ class TrainConfig:
         recorded_when_set=True,
         unrecorded=0.0,
     )
-    hold_horizon: int = field(
-        0,
-        "hold, settle, stop: steps over which a held-goal candidate is judged (its goal is the object's place "
-        "that many steps on); 0: H. Below H it shortens those replays, which dominate SELECT's work at a long H",
-        recorded_when_set=True,
-    )
-    rest_horizon: int = field(
-        0,
-        "rest: 0 looks for resting places within H; above H, Algorithm 2's goals keep H and resting places "
-        "are looked for up to rest_horizon steps ahead (below the episode length)",
-        recorded_when_set=True,
-    )
     algo: str = field("splid", "learner: " + ", ".join(f"{x.name} ({x.summary})" for x in registry.LEARNERS.values()))
     select: bool = field(True, "SELECT by first hit time; --no-select stores every relabelled pair (ablation)")
     relabel: str = field(
         None,
         "splid/pchid candidates: paper (Algorithm 2 exactly), hold (also steps whose goal is already "
-        "achieved and held for H steps, kept when the policy is not at the goal after H steps), settle "
-        "(experimental: hold, and a moved goal only where the object then stays there H steps; every "
-        "verdict at the final step), rest (settle with one moved goal per explored step: the latest h "
-        "at which the object rests there, so a strike's resting place is one candidate, not one per h) "
-        "or stop (hold, with the held pairs labelled by the zero action: stand still at a reached goal)",
-    )
-    select_radius: float = field(
-        1.0,
-        "fraction of the task's success threshold within which relabelling and SELECT count a goal as "
-        "reached (1: the task's own, as in Algorithm 2; below 1 the policy learns to bring the object nearer)",
+        "achieved and held for H steps, kept when the policy is not at the goal after H steps) or stop "
+        "(hold, with the held pairs labelled by the zero action: stand still at a reached goal)",
     )
     gcsl_relabel: str = field(
         "final", "gcsl: the later goal each step is paired with: final (the episode's last) or future (uniform)"
@@ -140,14 +129,6 @@ class TrainConfig:
         "parallel SELECT replay lanes per T x N explored steps, up to H (speed only, never a verdict): above 1 "
         "an explored step's candidates replay side by side in fewer rounds (a GPU steps a wider batch in little "
         "more time, up to a point)",
-    )
-    held_share: float = field(
-        0.0,
-        "splid, pchid with held goals (relabel hold, settle, rest or stop): the share of each behaviour-cloning "
-        "minibatch drawn from the buffer's held-goal pairs, those whose goal is where the object already is, "
-        "which teach staying on a reached goal (0: uniform over every pair, the paper's sampling)",
-        recorded_when_set=True,
-        unrecorded=0.0,
     )
     buffer_size: int = field(None, "relabel buffer capacity (FIFO)")
     buffer_window: int = field(
@@ -169,7 +150,7 @@ class TrainConfig:
     batch_size: int = field(None, "behaviour-cloning minibatch size")
     bc_steps: int = field(None, "behaviour-cloning gradient steps per iteration (with bc_reuse: at most)")
     bc_reuse: float = field(
-        0.0,
+        None,
         "cloning learners: behaviour-cloning samples per newly stored pair, so an iteration runs ceil(bc_reuse x new "
         "pairs / batch_size) steps, at least 1 and at most bc_steps; SELECT keeps fewer pairs as the policy improves, "
         "and a fixed step count then trains ever longer on the same pairs (the authors' code: 30 samples per new "
@@ -177,7 +158,11 @@ class TrainConfig:
         recorded_when_set=True,
         unrecorded=0.0,
     )
-    learning_rate: float = field(None, "Adam learning rate of the behaviour-cloning step")
+    learning_rate: float = field(None, "learning rate of the behaviour-cloning step")
+    optimiser: str = field(
+        None, "behaviour cloning's optimiser: adam or rmsprop (PyTorch's, the authors' code's)",
+        recorded_when_set=True, unrecorded="adam",
+    )  # fmt: skip
     policy_ema: float = field(
         None,
         "Polyak average of the cloned parameters that acts (explore, SELECT, eval): "
@@ -217,9 +202,11 @@ class TrainConfig:
         "pick_and_place's grasped training starts off)",
     )
     her_options: str = field(
-        "", "her only: HER's settings as KEY=VALUE[,KEY=VALUE...], e.g. batch_size=256,hidden=64,64"
+        "", "her only: HER's settings as KEY=VALUE[,KEY=VALUE...], as the --her-* flags give them to config.json"
     )
-    es_options: str = field("", "es only: ES's settings as KEY=VALUE[,KEY=VALUE...], e.g. population=512,sigma=0.05")
+    es_options: str = field(
+        "", "es only: ES's settings as KEY=VALUE[,KEY=VALUE...], as the --es-* flags give them to config.json"
+    )
 
     def __post_init__(self):
         for f in dataclasses.fields(self):  # a config.json may hold any JSON: each value's type first
@@ -241,15 +228,18 @@ class TrainConfig:
                 f"{per_generation} episodes per generation",
             )
             object.__setattr__(self, "num_envs", per_generation)
-        task, own = TASK_DEFAULTS[self.env], learner.task_defaults.get(self.env, {})
-        defaults = {k: v for k, v in {**task, **own}.items() if k != "env_options"}
-        options = {  # option by option: the task's, the learner's on that task, then the given ones (their
-            # syntax is checked here, the fields where the task is built)
-            **parse_overrides(task.get("env_options", "")),
-            **parse_overrides(own.get("env_options", "")),
+        check(self.preset in presets.PRESETS, "preset", self.preset, "one of " + ", ".join(presets.PRESETS))
+        defaults = presets.defaults(self.env, learner.name, self.preset)
+        options = {  # option by option: the preset's, then the given ones (their syntax is checked here, the
+            # fields where the task is built)
+            **parse_overrides(defaults.pop("env_options", "")),
             **parse_overrides(self.env_options or ""),
         }
         object.__setattr__(self, "env_options", format_overrides(options))
+        if defaults.get(learner.options or ""):  # the preset's own settings of the learner, the given ones on top
+            text = merged_options(learner.settings, defaults.pop(learner.options), getattr(self, learner.options),
+                                  learner.options, learner.name)  # fmt: skip
+            object.__setattr__(self, learner.options, text)
         if self.horizon_end is None:  # a task's falling horizon goes with its own H, not with one the caller set
             task_end = defaults["horizon_end"] if self.horizon is None else 0
             object.__setattr__(self, "horizon_end", task_end if registry.reads(learner.name, "horizon_end") else 0)
@@ -311,9 +301,7 @@ class TrainConfig:
     def check_env(self, env: envs.GoalEnv) -> None:
         """Checks that need the task's sizes."""
         last = env.episode_length - 1
-        for name, lowest in (("horizon", 1), ("rest_horizon", 0)):
-            value = getattr(self, name)
-            check(value <= last, name, value, f"an integer in [{lowest}, {last}] (below the episode length)")
+        check(self.horizon <= last, "horizon", self.horizon, f"an integer in [1, {last}] (below the episode length)")
         fingers = env.moves_fingers
         allowed = f"an integer in [1, {env.episode_length}]" if fingers else "1 on this task, whose fingers are locked"
         ok = self.gripper_hold <= (env.episode_length if fingers else 1)
@@ -339,7 +327,11 @@ class TrainConfig:
         unrecorded = cls.unrecorded_values()
         if saved.get("algo") == "her" and saved.get("her_defaults") != HER_DEFAULTS and "her_options" not in changes:
             saved = {**saved, "her_options": _on_baselines(saved.get("her_options", ""))}
-        cfg = cls(**{**unrecorded, **{k: v for k, v in saved.items() if k not in PROVENANCE}, **changes})
+        for name, value in RETIRED.items():
+            allowed = f"a run this version can resume: its {name}={saved.get(name)!r} left the package"
+            check(saved.get(name, value) == value, "resume", saved.get("run_dir"), allowed)
+        kept = {k: v for k, v in saved.items() if k not in PROVENANCE and k not in RETIRED}
+        cfg = cls(**{**unrecorded, **kept, **changes})
         options = changes.get("env_options", saved.get("env_options"))
         if isinstance(options, str):  # checked by the construction above
             object.__setattr__(cfg, "env_options", options)
@@ -356,115 +348,3 @@ def _on_baselines(text: Any) -> Any:
     given = {part.partition("=")[0].strip() for part in text.split(",") if "=" in part}
     changed = {name: getattr(recorded, name) for name in given}
     return options_text(HerConfig(), **{**BASELINES, **changed})
-
-
-_POINT = dict(
-    relabel="paper",
-    horizon=8,
-    horizon_end=0,
-    iterations=100,
-    select_lanes=1.0,
-    num_envs=32,
-    buffer_size=200_000,
-    buffer_window=0,
-    buffer_window_grow=0,
-    batch_size=256,
-    bc_steps=100,
-    learning_rate=1e-3,
-    policy_ema=0.0,
-    hidden=(64, 64, 64),
-    normalise=True,
-    relative_goal=False,
-    sigma_end=1.0,
-    sigma_anneal=1,
-    eval_every=5,
-    eval_episodes=200,
-    eval_subgoal_reach=0.0,
-    explore_subgoal_reach=0.0,
-)
-_FETCH = dict(
-    relabel="paper",
-    horizon=8,
-    horizon_end=0,
-    iterations=200,
-    select_lanes=1.0,
-    num_envs=256,
-    buffer_size=1_000_000,
-    buffer_window=0,
-    buffer_window_grow=0,
-    batch_size=1024,
-    bc_steps=200,
-    learning_rate=1e-3,
-    policy_ema=0.0,
-    hidden=(256, 256, 256),
-    normalise=True,
-    relative_goal=False,
-    sigma_end=1.0,
-    sigma_anneal=1,
-    eval_every=5,
-    eval_episodes=500,
-    eval_subgoal_reach=0.0,
-    explore_subgoal_reach=0.0,
-)
-# PickAndPlace's SPLID settings, which Slide shares without the grasped starts: held goals, Push's earlier settings
-# at 512 envs, exploring and evaluated steered at subgoals within 0.10 m. The reaches were chosen on tuning seeds on
-# both tasks (evaluation: the best of 0.05 to 0.20 m on PickAndPlace, 0.05 to 0.30 m on Slide; exploration: against
-# 0 on both, and 0.20 m on Slide) and held on seeds that chose nothing.
-_HELD_STEERED: dict[str, Any] = {
-    **_FETCH,
-    "num_envs": 512,
-    "relabel": "hold",
-    "normalise": False,
-    "relative_goal": True,
-    "sigma_end": 0.5,
-    "sigma_anneal": 50,
-    "policy_ema": 0.98,
-    "learning_rate": 5e-4,
-    "eval_subgoal_reach": 0.1,
-    "explore_subgoal_reach": 0.1,
-}
-# Push's, Reach's, Slide's and PickAndPlace's settings are those that learned best where they were compared (on
-# PickAndPlace: with the reference's finger joints and half the training episodes started with the cube grasped, HER
-# 2017's protocol; evaluation starts are standard; Slide: against Algorithm 2 at 1,024 envs) (experiments/NOTES.md,
-# "Task defaults" and the tables moved from BENCHMARKS.md; BENCHMARKS.md holds what the defaults reach).
-TASK_DEFAULTS: dict[str, dict[str, Any]] = {
-    "point": _POINT,
-    "reach": {**_FETCH, "iterations": 20, "num_envs": 64, "relative_goal": True},
-    "push": {
-        **_FETCH,
-        "iterations": 80,
-        "num_envs": 125,
-        "relabel": "stop",
-        "horizon": 12,
-        "horizon_end": 8,
-        "normalise": False,
-        "relative_goal": True,
-        "sigma_end": 0.2,
-        "sigma_anneal": 80,
-        # the newest 50k pairs alone learn fast and fall late, as the buffer turns over; all 200k hold the peak but
-        # start slower. The window widening from 50k to 200k keeps both: its 200 iterations were chosen against 100
-        # and 400 by the mean final step over a run to the paper's 100,000 episodes
-        "buffer_size": 200_000,
-        "buffer_window": 50_000,
-        "buffer_window_grow": 200,
-        "policy_ema": 0.98,
-        "learning_rate": 5e-4,
-        "eval_subgoal_reach": 0.1,  # the best of 0.10 to 0.30 m: near the buffer's median goal distance from the cube
-        "explore_subgoal_reach": 0.1,  # against 0: the explored pushes are the short ones the policy is taught, faster
-    },
-    "slide": {
-        **_HELD_STEERED,
-        # where the final step peaks; it falls after, while the any step holds
-        "iterations": 70,
-        # 100k reach the same peak later
-        "buffer_size": 50_000,
-    },
-    "pick_and_place": {
-        **_HELD_STEERED,
-        "env_options": "grasped_starts=0.5",
-        "iterations": 40,
-        "buffer_size": 100_000,  # 50k turned over in a few iterations as SELECT's intake shrank: the final step fell
-    },
-    "reacher": {**_POINT, "iterations": 40},
-    "sawyer_door": {**_POINT, "iterations": 40},
-}

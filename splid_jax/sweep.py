@@ -31,15 +31,18 @@ from splid_jax.cli import (  # noqa: E402
     add_compile_cache_flag,
     add_config_flags,
     add_launch_flags,
+    add_learner_flags,
     explicit_values,
+    flag_error,
     interrupts_now,
     refuse_unread,
     start_processes,
     use_compile_cache,
 )
 from splid_jax.common.errors import InvalidConfig, check  # noqa: E402
-from splid_jax.config import TASK_DEFAULTS, TrainConfig  # noqa: E402
+from splid_jax.config import TrainConfig  # noqa: E402
 from splid_jax.learners import registry  # noqa: E402
+from splid_jax.presets import TUNED, TUNED_LEARNERS  # noqa: E402
 from splid_jax.runtime import (  # noqa: E402
     checkpoint,
     loop,
@@ -166,9 +169,8 @@ def build_parser() -> Parser:
         epilog="Exit codes as train's: 0 done, 2 bad input (nothing written), 3 stopped, 130 Ctrl-C, 143 SIGTERM.",
     )
     # --sigmas and --horizons replace the single values
-    add_config_flags(
-        parser, TrainConfig, TASK_DEFAULTS, exclude=frozenset({"sigma", "horizon"}), per_algo=registry.task_defaults()
-    )
+    add_config_flags(parser, TrainConfig, TUNED, exclude=frozenset({"sigma", "horizon"}), per_algo=TUNED_LEARNERS)
+    add_learner_flags(parser)
     parser.add_argument("--seeds", type=int, default=None, help="seeds per grid point (default: 4)")
     parser.add_argument("--sigmas", default=None, help="comma-separated sigma values (default: 1.0)")
     parser.add_argument(
@@ -292,7 +294,7 @@ def main(argv: list[str] | None = None) -> int:
             loop.run(cfg, env, members=lanes, resume=bool(ns.resume), quiet=ns.quiet, on_record=on_record)
         interrupts_now(f"after the sweep completed ({cfg.run_dir} is whole; --resume {cfg.run_dir} draws its figure)")
     except InvalidConfig as err:
-        print(f"{parser.prog}: error: {err}", file=sys.stderr)
+        print(f"{parser.prog}: error: {flag_error(err, parser)}", file=sys.stderr)
         return 2
     except loop.Interrupted as stop:
         return stop.exit_code

@@ -24,7 +24,9 @@ from splid_jax.cli import (  # noqa: E402
     add_compile_cache_flag,
     add_config_flags,
     add_launch_flags,
+    add_learner_flags,
     explicit_values,
+    flag_error,
     interrupts_now,
     refuse_unread,
     start_processes,
@@ -32,8 +34,8 @@ from splid_jax.cli import (  # noqa: E402
 )
 from splid_jax.common.errors import InvalidConfig  # noqa: E402
 from splid_jax.common.paths import unreadable  # noqa: E402
-from splid_jax.config import PROVENANCE, TASK_DEFAULTS, TrainConfig  # noqa: E402
-from splid_jax.learners import registry  # noqa: E402
+from splid_jax.config import PROVENANCE, RETIRED, TrainConfig  # noqa: E402
+from splid_jax.presets import TUNED, TUNED_LEARNERS  # noqa: E402
 from splid_jax.runtime import checkpoint, loop, multihost, progress  # noqa: E402
 from splid_jax.runtime.loop import RunStopped  # noqa: E402
 from splid_jax.runtime.run_files import EXPORT, MAY_CHANGE_ON_RESUME, env_settings  # noqa: E402
@@ -65,7 +67,8 @@ def build_parser() -> argparse.ArgumentParser:
         "disk refusing a write (the last whole checkpoint kept), "
         "130 Ctrl-C, 143 SIGTERM (both keep the newest whole state as a checkpoint for --resume).",
     )
-    add_config_flags(parser, TrainConfig, TASK_DEFAULTS, per_algo=registry.task_defaults())
+    add_config_flags(parser, TrainConfig, TUNED, per_algo=TUNED_LEARNERS)
+    add_learner_flags(parser)
     parser.add_argument("--resume", metavar="RUN_DIR", help="continue the run saved in RUN_DIR (its config.json)")
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     parser.add_argument(
@@ -102,7 +105,11 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
     try:
         with open(path) as fh:
             saved = json.load(fh)
-        unknown = sorted(set(saved) - names - set(PROVENANCE)) if isinstance(saved, dict) else ["(not an object)"]
+        unknown = (
+            sorted(set(saved) - names - set(PROVENANCE) - set(RETIRED))
+            if isinstance(saved, dict)
+            else ["(not an object)"]
+        )
     except (OSError, ValueError):  # unreadable, not UTF-8, not JSON
         unknown = ["(not JSON)"]
     if unknown:
@@ -126,7 +133,7 @@ def main(argv: list[str] | None = None) -> int:
         rec = run(cfg, env, resume=resume, quiet=ns.quiet, tensorboard=ns.tensorboard)
         interrupts_now(f"after the run completed ({cfg.run_dir} is whole)")
     except InvalidConfig as err:
-        print(f"{parser.prog}: error: {err}", file=sys.stderr)
+        print(f"{parser.prog}: error: {flag_error(err, parser)}", file=sys.stderr)
         return 2
     except loop.Interrupted as stop:
         return stop.exit_code

@@ -97,6 +97,18 @@ def options_text(settings, **changed) -> str:
     return ",".join(f"{k}={show(v)}" for k, v in values.items() if v != defaults[k])
 
 
+def merged_options(cls, base: str, given: str, field: str, prefix: str) -> str:
+    """``given`` options text on top of ``base`` (a preset's), key by key, as one text that names every key
+    either gives, so that reading it again against any defaults gives the same settings."""
+    values = {}
+    for text in (base, given):
+        settings = parse_options(cls, text, field, prefix)
+        keys = [part.partition("=")[0].strip() for part in text.split(",") if "=" in part]
+        values.update({key: getattr(settings, key) for key in keys})
+    show = lambda v: ",".join(map(str, v)) if isinstance(v, tuple) else str(v)  # noqa: E731
+    return ",".join(f"{key}={show(value)}" for key, value in values.items())
+
+
 def typed_fields(cls, values: dict[str, Any], prefix: str) -> dict[str, Any]:
     """``values`` (as ``parse_overrides`` reads them) as the declared types of ``cls``'s fields; an
     unknown key or a value of another type fails naming ``prefix.KEY``."""

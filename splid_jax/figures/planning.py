@@ -11,10 +11,11 @@ from typing import Any
 
 import envs
 from splid_jax.common.errors import check
-from splid_jax.config import TASK_DEFAULTS, TrainConfig
+from splid_jax.config import TrainConfig
 from splid_jax.figures.registry import METHODS, Spec, member_name
 from splid_jax.figures.settings import reads
 from splid_jax.learners import registry as learners
+from splid_jax.presets import TUNED
 
 # Exploration episodes per method by default (the paper's x axes); other tasks: their default run's.
 BUDGETS = {"push": 20_000, "slide": 100_000, "pick_and_place": 100_000}
@@ -34,7 +35,7 @@ def default_budget(env: str) -> int:
     """The task's budget: the paper's for the Fetch tasks, the default run's (iterations x envs) otherwise."""
     if env in BUDGETS:
         return BUDGETS[env]
-    return TASK_DEFAULTS[env]["iterations"] * TASK_DEFAULTS[env]["num_envs"]
+    return TUNED[env]["iterations"] * TUNED[env]["num_envs"]
 
 
 @dataclasses.dataclass(frozen=True)

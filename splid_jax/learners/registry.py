@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
-from collections.abc import Mapping
 from typing import Any
 
 from splid_jax.common.errors import InvalidConfig, check
@@ -31,16 +30,11 @@ class Learner:
     sets_num_envs: bool = False  # its settings fix the episodes per iteration: --num-envs is not read
     grows_horizon: bool = False  # the learning horizon grows 1, 2, ..., H over the run (PCHID's curriculum)
     clones_every_pair: bool = False  # every relabelled pair is cloned, without SELECT (GCSL)
-    task_defaults: Mapping[str, Mapping[str, Any]] = dataclasses.field(default_factory=dict)
 
 
 IMITATION_FIELDS = tuple(f.name for f in dataclasses.fields(ImitationConfig))
-# SELECT's settings and the share of the held pairs it makes in BC's batches, read by SPLID and PCHID; GCSL
-# clones every relabelled pair and selects nothing
-SELECT_FIELDS = (
-    "horizon", "horizon_end", "hold_horizon", "rest_horizon", "select", "relabel", "select_radius", "select_lanes",
-    "held_share",
-)
+# SELECT's settings, read by SPLID and PCHID; GCSL clones every relabelled pair and selects nothing
+SELECT_FIELDS = ("horizon", "horizon_end", "select", "relabel", "select_lanes")
 _CLONING = tuple(f for f in IMITATION_FIELDS if f not in (*SELECT_FIELDS, "gcsl_relabel", "pchid_every"))
 _TRAINER = "splid_jax.learners.splid.trainer:Trainer"
 _IMITATION = dict(
@@ -55,21 +49,11 @@ _IMITATION = dict(
         "policy_ema",
         "gripper_hold",
         "explore_subgoal_reach",
-        "held_share",
         "bc_reuse",
         "buffer_window",
         "buffer_window_grow",
     ),
 )
-# HER on the Fetch tasks runs as mrl's benchmarks: 8 envs, one episode each per iteration, evaluated every 200
-# episodes, to mrl's budgets (Push and PickAndPlace 1M transitions, Slide 2.5M) on the standard tasks (no grasped
-# starts). Baselines' protocol (HerConfig's BASELINES) explores 16 episodes per cycle: num_envs=16.
-_HER_FETCH = dict(num_envs=8, eval_every=25)
-# Steered exploration and Push's widening window were chosen for SPLID; the imitation baselines explore towards the
-# goal, as their papers do, and clone Push's newest 50,000 pairs, the buffer they were measured with
-_BASELINE_DEFAULTS = {task: {"explore_subgoal_reach": 0.0} for task in ("push", "slide", "pick_and_place")}
-_BASELINE_DEFAULTS["push"].update(buffer_size=50_000, buffer_window=0, buffer_window_grow=0)
-
 LEARNERS: dict[str, Learner] = {
     learner.name: learner
     for learner in (
@@ -81,7 +65,6 @@ LEARNERS: dict[str, Learner] = {
             reads=(*_CLONING, "gcsl_relabel"),
             **_IMITATION,
             clones_every_pair=True,
-            task_defaults=_BASELINE_DEFAULTS,
         ),
         Learner(
             "pchid",
@@ -90,8 +73,6 @@ LEARNERS: dict[str, Learner] = {
             reads=(*_CLONING, *(f for f in SELECT_FIELDS if f != "horizon_end"), "pchid_every"),  # its own curriculum
             **_IMITATION,
             grows_horizon=True,
-            # SPLID's falling horizon on Push is not PCHID's
-            task_defaults={**_BASELINE_DEFAULTS, "push": {**_BASELINE_DEFAULTS["push"], "horizon": 8}},
         ),
         Learner(
             "her",
@@ -99,12 +80,6 @@ LEARNERS: dict[str, Learner] = {
             "splid_jax.learners.her.learner:HER",
             HerConfig,
             options="her_options",
-            task_defaults={
-                "reach": {**_HER_FETCH, "iterations": 250},
-                "push": {**_HER_FETCH, "iterations": 2500},
-                "slide": {**_HER_FETCH, "iterations": 6250},
-                "pick_and_place": {**_HER_FETCH, "iterations": 2500, "env_options": "grasped_starts=0"},
-            },
         ),
         Learner(
             "es",
@@ -145,11 +120,6 @@ def ignores(name: str) -> tuple[str, ...]:
 def reads(name: str, field: str) -> bool:
     """Whether learner ``name`` reads run-config ``field``."""
     return field not in ignores(name) and not (field == "num_envs" and get(name).sets_num_envs)
-
-
-def task_defaults() -> dict[str, Mapping[str, Mapping[str, Any]]]:
-    """Each learner's own defaults per task, for those that have any."""
-    return {x.name: x.task_defaults for x in LEARNERS.values() if x.task_defaults}
 
 
 def make_algorithm(cfg, env, mesh=None):

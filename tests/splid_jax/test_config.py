@@ -54,12 +54,8 @@ def test_sigma_schedule_outside_its_range_names_the_field(field, value):
 @pytest.mark.parametrize(
     "fields",
     [
-        {"hold_horizon": -1},
-        {"hold_horizon": 9},  # above the horizon 8
         {"horizon_end": -1},
         {"horizon_end": 9},  # above the horizon 8
-        {"rest_horizon": 16},  # without relabel=rest
-        {"rest_horizon": 8, "relabel": "rest"},  # not above the horizon
     ],
 )
 def test_select_horizons_outside_their_range_name_the_field(fields):
@@ -73,15 +69,6 @@ def test_select_lanes_outside_zero_to_the_horizon_names_the_field(lanes):
     with pytest.raises(InvalidConfig, match="select_lanes"):
         TrainConfig(env="point", select_lanes=lanes)
     assert TrainConfig(env="point", select_lanes=8).select_lanes == 8
-
-
-@pytest.mark.parametrize(
-    "fields", [{"held_share": -0.1}, {"held_share": 1.0}, {"held_share": 0.2, "relabel": "paper"}]
-)
-def test_held_share_outside_its_range_or_without_held_goals_names_the_field(fields):
-    with pytest.raises(InvalidConfig, match="held_share"):
-        TrainConfig(env="point", **fields)
-    assert TrainConfig(env="point", held_share=0.2, relabel="hold").held_share == 0.2
 
 
 @pytest.mark.parametrize(
@@ -101,11 +88,6 @@ def test_a_buffer_window_beyond_the_buffer_or_a_negative_reuse_names_the_field(f
     assert TrainConfig(env="point", buffer_size=20_000, buffer_window=5_000, buffer_window_grow=40).buffer_window_grow
 
 
-def test_rest_horizon_within_the_episode_is_accepted():
-    cfg = TrainConfig(env="point", relabel="rest", horizon=4, rest_horizon=16, hold_horizon=2)
-    assert (cfg.rest_horizon, cfg.hold_horizon) == (16, 2)
-
-
 def test_gripper_hold_is_checked_against_the_task():
     import envs
 
@@ -123,11 +105,12 @@ def test_gripper_hold_is_checked_against_the_task():
 def test_a_checkpoint_records_a_later_setting_only_when_it_is_set():
     from splid_jax.runtime.run_files import identity
 
-    later = ("hold_horizon", "rest_horizon", "gripper_hold", "horizon_end")
+    later = ("gripper_hold", "horizon_end", "preset", "optimiser")
     assert not set(later) & set(identity(TrainConfig(env="pick_and_place")))  # as runs recorded before them
-    changed = identity(TrainConfig(env="pick_and_place", hold_horizon=4, gripper_hold=5, horizon_end=6))
-    assert (changed["hold_horizon"], changed["gripper_hold"], changed["horizon_end"]) == (4, 5, 6)
-    assert "rest_horizon" not in changed
+    changed = identity(TrainConfig(env="pick_and_place", gripper_hold=5, horizon_end=6, preset="paper"))
+    assert (changed["gripper_hold"], changed["horizon_end"], changed["preset"], changed["optimiser"]) == (
+        5, 6, "paper", "rmsprop"
+    )
 
 
 def test_push_horizon_falls_from_12_to_8_unless_the_caller_sets_h():

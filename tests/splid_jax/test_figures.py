@@ -338,10 +338,10 @@ def test_a_stopped_method_keeps_its_seconds_for_the_resumed_total(tmp_path, monk
 
 def test_set_reads_each_value_as_its_field_declares_it():
     sets = figures.parse_sets(
-        ["hidden=32,32", "select_radius=0.5", "gcsl.gcsl_relabel=future", "splid.normalise=false", "bc_steps=7"],
+        ["hidden=32,32", "policy_ema=0.5", "gcsl.gcsl_relabel=future", "splid.normalise=false", "bc_steps=7"],
         ("splid", "gcsl"),
     )
-    assert sets[None] == {"hidden": (32, 32), "select_radius": 0.5, "bc_steps": 7}
+    assert sets[None] == {"hidden": (32, 32), "policy_ema": 0.5, "bc_steps": 7}
     assert sets["gcsl"] == {"gcsl_relabel": "future"} and sets["splid"] == {"normalise": False}
     for item, field in (("hidden=32,x", "hidden"), ("bc_steps=2.5", "bc_steps"), ("normalise=maybe", "normalise")):
         with pytest.raises(figures.InvalidConfig, match=f"invalid {field}="):

@@ -62,36 +62,36 @@ def final_params(run_dir):
 @pytest.mark.parametrize(
     "args,field",
     [
-        (["--sigma", "-1"], "sigma"),
-        (["--horizon", "0"], "horizon"),
-        (["--horizon", "50"], "horizon"),
-        (["--num-envs", "0"], "num_envs"),
-        (["--policy-ema", "1"], "policy_ema"),
-        (["--env", "nope"], "env"),
-        (["--iterations", "7", "--eval-every", "5"], "iterations"),
-        (["--env-options", "success_radius"], "env_options"),
+        (["--sigma", "-1"], "--sigma "),
+        (["--horizon", "0"], "--horizon "),
+        (["--horizon", "50"], "--horizon "),
+        (["--num-envs", "0"], "--num-envs "),
+        (["--policy-ema", "1"], "--policy-ema "),
+        (["--env", "nope"], "--env "),
+        (["--iterations", "7", "--eval-every", "5"], "--iterations "),
+        (["--env-options", "success_radius"], "--env-options "),
         (["--env-options", "bogus=1"], "point.bogus"),
-        (["--env-options", "max_episode_steps=8"], "horizon"),  # H = 8 must stay below the episode length
+        (["--env-options", "max_episode_steps=8"], "--horizon "),  # H = 8 must stay below the episode length
         (["--env-options", "max_episode_steps=abc"], "point.max_episode_steps"),
         (["--env-options", "success_radius=big"], "point.success_radius"),
         (["--env-options", "max_episode_steps=20.5"], "point.max_episode_steps"),
-        (["--seed", "99999999999999999999"], "seed"),
-        (["--sigma", "inf"], "sigma"),
-        (["--sigma", "nan"], "sigma"),
-        (["--num-envs", "100000000"], "num_envs"),  # refused from its shapes, before anything is allocated
-        (["--run-dir", ""], "run_dir"),
-        (["--run-dir", "bad-\udcff"], "run_dir"),  # a \xff byte in the name: orbax takes UTF-8 paths only
-        (["--bc-steps", "0"], "bc_steps"),  # no cloning step: the loss would be undefined
-        (["--gcsl-relabel", "future"], "gcsl_relabel"),  # flags the learner does not read
-        (["--pchid-every", "3"], "pchid_every"),
-        (["--algo", "gcsl", "--select"], "select"),
-        (["--algo", "gcsl", "--relabel", "settle"], "relabel"),
-        (["--algo", "gcsl", "--horizon", "3"], "horizon"),
-        (["--algo", "gcsl", "--select-radius", "0.5"], "select_radius"),
-        (["--algo", "pchid", "--gcsl-relabel", "final"], "gcsl_relabel"),
-        (["--iterations", str(10**20)], "iterations"),
-        (["--batch-size", "2000000000"], "batch_size=2000000000"),  # the sizes named are the ones given
-        (["--env-options", "success_radius=1,success_radius=2"], "env_options"),  # which one was meant?
+        (["--seed", "99999999999999999999"], "--seed "),
+        (["--sigma", "inf"], "--sigma "),
+        (["--sigma", "nan"], "--sigma "),
+        (["--num-envs", "100000000"], "--num-envs "),  # refused from its shapes, before anything is allocated
+        (["--run-dir", ""], "--run-dir "),
+        (["--run-dir", "bad-\udcff"], "--run-dir "),  # a \xff byte in the name: orbax takes UTF-8 paths only
+        (["--bc-steps", "0"], "--bc-steps "),  # no cloning step: the loss would be undefined
+        (["--gcsl-relabel", "future"], "--gcsl-relabel "),  # flags the learner does not read
+        (["--pchid-every", "3"], "--pchid-every "),
+        (["--algo", "gcsl", "--select"], "--select "),
+        (["--algo", "gcsl", "--relabel", "stop"], "--relabel "),
+        (["--algo", "gcsl", "--horizon", "3"], "--horizon "),
+        (["--algo", "gcsl", "--select-lanes", "0.5"], "--select-lanes "),
+        (["--algo", "pchid", "--gcsl-relabel", "final"], "--gcsl-relabel "),
+        (["--iterations", str(10**20)], "--iterations "),
+        (["--batch-size", "2000000000"], "--batch-size 2000000000"),  # the sizes named are the ones given
+        (["--env-options", "success_radius=1,success_radius=2"], "--env-options "),  # which one was meant?
     ],
 )
 def test_bad_values_stop_before_any_work(tmp_path, capsys, args, field):
@@ -121,7 +121,7 @@ def test_a_typo_is_one_line_pointing_at_help(tmp_path, capsys, args):
 def test_a_run_dir_under_proc_is_refused(capsys):
     assert main(["--run-dir", "/proc/splid-run"]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "run_dir" in err and "writable" in err
+    assert len(err.splitlines()) == 1 and "--run-dir" in err and "writable" in err
 
 
 def test_env_options_help_lists_every_tasks_fields(capsys):
@@ -141,7 +141,7 @@ def test_run_dir_that_is_a_file_is_refused(tmp_path, capsys):
 
 def test_help_documents_every_flag(capsys):
     """Every field of the run config is a flag with its help line, and every field of a learner's own
-    settings is listed with its default under its learner's group."""
+    settings is a flag of its own (``--her-batch-size``) with its default, under its learner's group."""
     with pytest.raises(SystemExit) as exc:
         main(["--help"])
     assert exc.value.code == 0
@@ -155,8 +155,19 @@ def test_help_documents_every_flag(capsys):
         if learner.options is not None:
             for f in dataclasses.fields(learner.settings):
                 default = ",".join(map(str, f.default)) if isinstance(f.default, tuple) else f.default
-                assert f"{f.name}={default} (" in out, f"{learner.name}.{f.name}"
-    assert "read only by splid, gcsl, pchid:" in out and "read only by her:" in out
+                flag = f"--{learner.name}-{f.name.replace('_', '-')}"
+                assert f"{flag} " in out and f"(default: {default})" in out, flag
+    assert "read only by splid, gcsl, pchid:" in out and "her's own settings (read only by her):" in out
+    assert "--preset PRESET" in out and "tuned (" in out and "paper (" in out
+
+
+def test_an_error_names_the_flags_the_user_typed(tmp_path, capsys):
+    assert main(["--env", "push", "--iterations", "3", "--run-dir", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "python -m splid_jax.train: error: invalid --iterations 3: must be a multiple of --eval-every 5"
+    assert main(["--algo", "her", "--her-batch-size", "0", "--run-dir", str(tmp_path / "run")]) == 2
+    assert "invalid --her-batch-size 0: must be an integer >= 1" in capsys.readouterr().err
+    assert not (tmp_path / "run").exists()
 
 
 @pytest.mark.slow
@@ -342,14 +353,14 @@ def test_bad_resumes_and_bad_saved_configs_are_one_line(tmp_path, capsys):
     capsys.readouterr()
     assert main(["--resume", str(run_dir), "--run-dir", str(tmp_path / "x"), "--iterations", "10"]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "invalid run_dir=" in err and "unset with --resume" in err
+    assert len(err.splitlines()) == 1 and "invalid --run-dir " in err and "unset with --resume" in err
     assert not (tmp_path / "x").exists()
     saved = json.loads(files["config.json"])
     for field, value in [("sigma", "high"), ("hidden", ["a", 64, 64]), ("num_envs", 32.5)]:
         (run_dir / "config.json").write_text(json.dumps({**saved, field: value}))
         assert main(["--resume", str(run_dir), "--iterations", "10"]) == 2
         err = capsys.readouterr().err.strip()
-        assert len(err.splitlines()) == 1 and f"invalid {field}=" in err, err
+        assert len(err.splitlines()) == 1 and f"invalid --{field.replace('_', '-')} " in err, err
     (run_dir / "config.json").write_bytes(files["config.json"])
     assert (run_dir / "metrics.jsonl").read_bytes() == files["metrics.jsonl"]
     assert checkpoint.latest_step(str(run_dir)) == 5

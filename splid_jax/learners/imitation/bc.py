@@ -55,24 +55,20 @@ def bc_epoch(
     batch_size: int,
     online=None,
     acting_step: float | jax.Array = 1.0,
-    held: jax.Array | None = None,
-    held_share: float | jax.Array = 0.0,
     active: jax.Array | None = None,
     window: jax.Array | None = None,
 ):
     """``num_steps`` minibatch steps from the buffer; returns (pstate, opt_state, online, mean loss).
-    ``held`` ([C] bool, the held-goal pairs) lets ``held_share`` of each batch come from them. With
-    ``active`` ([] int, traced) only the first ``active`` steps update: the rest are no-ops, so the shapes
+    With ``active`` ([] int, traced) only the first ``active`` steps update: the rest are no-ops, so the shapes
     stay static and each step draws the minibatch it draws with all steps taken. ``window``: batches come
     from the newest ``window`` pairs (``relabel_buffer.sample``)."""
     weight = (buf.size > 0).astype(jnp.float32)
-    slots = None if held is None else relabel_buffer.held_slots(held)
     taken = jnp.ones((num_steps,), bool) if active is None else jnp.arange(num_steps) < active
 
     def one(carry, step):
         ps, os, on = carry
         k, take = step
-        batch = relabel_buffer.sample(buf, k, batch_size, slots, held_share, window)
+        batch = relabel_buffer.sample(buf, k, batch_size, window)
         ps, os, on, loss = bc_step(policy, optimiser, ps, os, batch, weight * take, on, acting_step)
         return (ps, os, on), loss
 

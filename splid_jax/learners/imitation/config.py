@@ -9,15 +9,9 @@ import dataclasses
 
 from splid_jax.common.errors import check
 
-RELABELS = ("paper", "hold", "settle", "rest", "stop")
-HOLDING = ("hold", "settle", "rest", "stop")  # the relabellings that add held-goal candidates
+RELABELS = ("paper", "hold", "stop")  # splid.relabel.STRATEGIES, named here without importing JAX
 GCSL_RELABELS = ("final", "future")
-
-
-def select_modes(relabel: str) -> dict[str, bool]:
-    """SELECT's keyword switches (``splid.select.select``) for a ``--relabel`` value."""
-    settle = relabel in ("settle", "rest")
-    return {"hold": relabel in HOLDING, "settle": settle, "rest": relabel == "rest", "stop": relabel == "stop"}
+OPTIMISERS = ("adam", "rmsprop")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -29,15 +23,11 @@ class ImitationConfig:
     horizon_end: int
     gripper_hold: int
     explore_subgoal_reach: float
-    hold_horizon: int
-    rest_horizon: int
     select: bool
     relabel: str
-    select_radius: float
     gcsl_relabel: str
     pchid_every: int
     select_lanes: float
-    held_share: float
     buffer_size: int
     buffer_window: int
     buffer_window_grow: int
@@ -45,6 +35,7 @@ class ImitationConfig:
     bc_steps: int
     bc_reuse: float
     learning_rate: float
+    optimiser: str
     policy_ema: float
     hidden: tuple[int, ...]
     normalise: bool
@@ -53,7 +44,6 @@ class ImitationConfig:
     def __post_init__(self):
         check(self.relabel in RELABELS, "relabel", self.relabel, "one of " + ", ".join(RELABELS))
         check(self.gcsl_relabel in GCSL_RELABELS, "gcsl_relabel", self.gcsl_relabel, "final or future")
-        check(0 < self.select_radius <= 1, "select_radius", self.select_radius, "in (0, 1]")
         check(self.pchid_every >= 0, "pchid_every", self.pchid_every, "an integer >= 0")
         check(self.sigma >= 0, "sigma", self.sigma, ">= 0")
         check(0 <= self.sigma_end <= 1, "sigma_end", self.sigma_end, "in [0, 1] (a fraction of sigma)")
@@ -69,30 +59,10 @@ class ImitationConfig:
         check(reach >= 0, "explore_subgoal_reach", reach, "a distance >= 0 (0: no subgoals)")
         check(self.gripper_hold >= 1, "gripper_hold", self.gripper_hold, "an integer >= 1 (1: noise drawn every step)")
         check(
-            0 <= self.hold_horizon <= self.horizon,
-            "hold_horizon",
-            self.hold_horizon,
-            f"an integer in [0, {self.horizon}] (0: the learning horizon H; at most H)",
-        )
-        check(
-            self.rest_horizon == 0 or (self.relabel == "rest" and self.rest_horizon > self.horizon),
-            "rest_horizon",
-            self.rest_horizon,
-            f"0, or with relabel=rest an integer above the horizon {self.horizon}",
-        )
-        check(
             0 < self.select_lanes <= self.horizon,
             "select_lanes",
             self.select_lanes,
             f"in (0, {self.horizon}] (times the explored steps; at most the horizon, one lane per candidate)",
-        )
-        share = self.held_share
-        check(0 <= share < 1, "held_share", share, "in [0, 1) (0: uniform sampling)")
-        check(
-            share == 0 or self.relabel in HOLDING,
-            "held_share",
-            share,
-            f"0 with relabel={self.relabel}, which adds no held goals (they come with " + ", ".join(HOLDING) + ")",
         )
         check(self.buffer_size >= 1, "buffer_size", self.buffer_size, "an integer >= 1")
         window = self.buffer_window
@@ -106,5 +76,6 @@ class ImitationConfig:
         check(self.bc_steps >= 1, "bc_steps", self.bc_steps, "an integer >= 1 (no step leaves the loss undefined)")
         check(self.bc_reuse >= 0, "bc_reuse", self.bc_reuse, ">= 0 (0: bc_steps every iteration)")
         check(self.learning_rate > 0, "learning_rate", self.learning_rate, "> 0")
+        check(self.optimiser in OPTIMISERS, "optimiser", self.optimiser, "one of " + ", ".join(OPTIMISERS))
         check(0 <= self.policy_ema < 1, "policy_ema", self.policy_ema, "in [0, 1)")
         check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "hidden", self.hidden, "one or more widths >= 1")

@@ -5,8 +5,6 @@ pairs SELECT accepted."""
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import chex
 import jax
 import jax.numpy as jnp
@@ -54,49 +52,18 @@ def filled(buf: Buffer) -> jax.Array:
     return jnp.arange(buf.capacity) < buf.size
 
 
-def newest(buf: Buffer, window: jax.Array | int) -> jax.Array:
-    """[C] bool: the slots of the newest ``window`` pairs (all filled slots when ``window`` >= size)."""
-    age = (buf.ptr - 1 - jnp.arange(buf.capacity)) % buf.capacity  # 0: the last written
-    return filled(buf) & (age < window)
-
-
-class Held(NamedTuple):
-    """The buffer's held-goal pairs as a list of slots, made once per epoch of BC steps."""
-
-    slots: jax.Array  # [C] int32, the held pairs' slots first
-    count: jax.Array  # [] int32, how many of ``slots`` are held pairs
-
-
-def held_slots(held: jax.Array) -> Held:
-    """``held`` ([C] bool, one per slot) as the slots to draw held pairs from."""
-    slots = jnp.nonzero(held, size=held.shape[0], fill_value=0)[0].astype(jnp.int32)
-    return Held(slots, jnp.sum(held, dtype=jnp.int32))
-
-
 def sample(
     buf: Buffer,
     key: jax.Array,
     batch_size: int,
-    held: Held | None = None,
-    held_share: float | jax.Array = 0.0,
     window: jax.Array | int | None = None,
 ) -> tuple[jax.Array, jax.Array, jax.Array]:
     """Uniform over filled slots (with replacement). An empty buffer yields row 0 of zeros:
     callers weight the loss by ``size > 0``. With ``window``, uniform over the newest ``window`` pairs, as a
-    FIFO buffer of that capacity holds them; while they are all the pairs, the draw is the whole buffer's.
-
-    With ``held``, each row is drawn from the held pairs instead with probability ``held_share``
-    (while there are any): they are a few percent of the buffer, yet the only pairs that teach
-    staying on a reached goal. The uniform draw uses ``key`` alone, so at share 0 the batch is the
-    uniform one exactly."""
+    FIFO buffer of that capacity holds them; while they are all the pairs, the draw is the whole buffer's."""
     if window is None:
         idx = jax.random.randint(key, (batch_size,), 0, jnp.maximum(buf.size, 1))
     else:
         drawn = jax.random.randint(key, (batch_size,), 0, jnp.maximum(jnp.minimum(buf.size, window), 1))
         idx = jnp.where(buf.size <= window, drawn, (buf.ptr - 1 - drawn) % buf.capacity)
-    if held is not None:
-        k_pick, k_which = jax.random.split(jax.random.fold_in(key, 1))
-        which = held.slots[jax.random.randint(k_which, (batch_size,), 0, jnp.maximum(held.count, 1))]
-        use = (jax.random.uniform(k_pick, (batch_size,)) < held_share) & (held.count > 0)
-        idx = jnp.where(use, which, idx)
     return buf.obs[idx], buf.goal[idx], buf.action[idx]

@@ -2,25 +2,15 @@
 
 For every explored step t and every h in 1..H the candidate is (s_t, g' = m(s_{t+h}), a_t). SELECT
 restores s_t pursuing g' and runs the current deterministic policy for up to h steps: if the policy
-reaches g', the explored actions were no faster and the pair is rejected.
+reaches g', the explored actions were no faster and the pair is rejected. Which candidates an explored
+step gives, and their action labels, is the relabelling's (``relabel``).
 
 Most candidates need no replay (the object did not move: the policy "reaches" g' in zero steps), and
 a replay ends as soon as the policy hits g'. So SELECT runs as a work queue: a fixed number of
 vmapped replay lanes, each taking the next valid candidate from the queue as soon as its current one
 is decided, in one ``lax.while_loop`` that ends when the queue is empty. Every valid candidate is
 decided, no lane steps past its verdict, and the simulator step appears once in the compiled
-program (MJX compile time).
-
-``hold=True`` adds the candidates Algorithm 2 leaves out: those whose goal is already achieved at
-s_t and still achieved H steps later (the explored actions kept the object there). Their verdict is
-taken at the final step: the pair is kept only if the policy, restored at s_t, is NOT at g' after H
-steps. Without them the buffer never holds a state whose goal is achieved, so the policy is never
-shown what to do there and pushes through the goal.
-
-``stop=True`` labels those held pairs with the zero action instead of the explored one: on the Fetch
-tasks it holds the gripper where it is (the target is the current grip position, the fingers keep
-their opening), so at a goal already reached the policy is taught to stand still rather than to copy
-exploration noise that happened not to disturb the object."""
+program (MJX compile time)."""
 
 from __future__ import annotations
 
@@ -34,6 +24,7 @@ from envs.base import GoalEnv, State, step_batch
 from splid_jax.common.networks import Policy, PolicyState
 from splid_jax.learners.imitation.candidates import Candidates
 from splid_jax.learners.imitation.explore import Trajectory
+from splid_jax.learners.splid.relabel import STRATEGIES, hindsight
 
 
 def num_candidates(episode_length: int, max_horizon: int, num_envs: int) -> int:
@@ -59,21 +50,6 @@ class _Queue(NamedTuple):
     replay_steps: jax.Array  # [] int32
 
 
-def within(env: GoalEnv, achieved: jax.Array, goal: jax.Array, radius: float = 1.0) -> jax.Array:
-    """The task's success test with its threshold scaled by ``radius`` (tasks whose success is a
-    distance threshold): 1 is the task's own; below 1 SELECT asks for the object nearer the goal."""
-    if radius == 1.0:
-        return env.success(achieved, goal)
-    return env.success(goal + (achieved - goal) / radius, goal)
-
-
-def held_pairs(env: GoalEnv, obs: jax.Array, goal: jax.Array, radius: float = 1.0) -> jax.Array:
-    """Which stored (observation, goal) pairs are held-goal ones: the goal already achieved at the
-    observation, the test that sets SELECT's held candidates apart from its moved ones."""
-    start = env.achieved_goal_start
-    return within(env, obs[..., start : start + env.goal_size], goal, radius)
-
-
 def replay_queue(
     env: GoalEnv,
     policy: Policy,
@@ -85,7 +61,6 @@ def replay_queue(
     valid: jax.Array,
     lanes: int,
     at_final: jax.Array | None = None,
-    radius: float = 1.0,
 ) -> tuple[jax.Array, jax.Array]:
     """For every valid candidate c: does the policy, restored at ``starts[start_of[c]]`` pursuing
     ``goals[c]``, hit it within ``horizon_of[c]`` steps (where ``at_final[c]``: is it at the goal
@@ -119,7 +94,7 @@ def replay_queue(
     def body(q: _Queue) -> _Queue:
         s = step_batch(env, q.state, policy.act(pstate, q.state.obs, q.state.desired_goal))
         steps = q.steps + 1
-        hit = within(env, s.achieved_goal, s.desired_goal, radius) & ~s.invalid
+        hit = env.success(s.achieved_goal, s.desired_goal) & ~s.invalid
         done = q.active & ((hit & ~at_final[q.cand]) | (steps >= horizon_of[q.cand]))
         reached = q.reached.at[jnp.where(done, q.cand, m)].set(hit)
         # finished lanes take the next candidates in queue order
@@ -147,79 +122,26 @@ def select(
     traj: Trajectory,
     max_horizon: int,
     horizon: jax.Array,
-    use_select: bool,
+    use_select: bool = True,
     lanes: float = 1.0,
-    hold: bool = False,
-    settle: bool = False,
-    radius: float = 1.0,
-    stop: bool = False,
-    hold_horizon: int = 0,
-    rest: bool = False,
-    rest_horizon: int = 0,
+    relabel: str = "paper",
 ) -> Candidates:
-    """``max_horizon`` fixes the shapes; ``horizon`` (traced, <= max_horizon) masks the candidates
-    of larger h, so runs with different H share one compiled program. ``use_select=False`` is the
-    ablation: every valid pair is stored, nothing is replayed. ``lanes`` sets the width of the
-    replay batch as a multiple of the T x N explored steps (at most H); it changes speed, never a verdict.
-    ``hold`` adds the held-goal candidates (module docstring), one per explored step, at h = H.
-    ``settle`` (with ``hold``) keeps only moved candidates whose object then stays at g' for the next
-    H steps (or to the episode's end), and judges every candidate at its final step: the explored
-    actions are imitated where they leave the object at g' and the policy does not. ``radius`` scales
-    the task's success threshold for every test here (``within``). ``stop`` (with ``hold``) labels the
-    held candidates with the zero action (module docstring). ``hold_horizon`` (> 0) takes the held
-    candidates at that h instead of H: at a long H their replays, one per explored step, would
-    outweigh every other. ``rest`` (with ``settle``) keeps, of each explored step's settled moved
-    candidates, only the one of largest h: their goals all lie within the threshold of one resting
-    place, so the others would replay the same question with less time to answer it. ``rest_horizon``
-    (> 0, with ``rest``; ``max_horizon`` covers it) keeps Algorithm 2's candidates within ``horizon``
-    and adds resting places up to ``rest_horizon`` steps ahead, judged at their final step: a strike
-    and where it leaves the object can lie further apart than the steps a first hit is learnt over."""
-    T, H = env.episode_length, max_horizon
-    n = traj.actions.shape[1]
-    hs = jnp.arange(1, H + 1)
-    t = jnp.arange(T)
-    later = jnp.minimum(t[None, :] + hs[:, None], T)  # [H, T] index of s_{t+h}, clamped
-    goal = traj.achieved[later]  # [H, T, N, G]
-    real = (t[None, :] + hs[:, None] <= T)[..., None] & ~traj.invalid[:T][None] & ~traj.invalid[later]
-    achieved_at_t = within(env, traj.achieved[:T][None], goal, radius)
-    away = real & ~achieved_at_t
-    moved = away & (hs <= horizon)[:, None, None]  # Algorithm 2's candidates
-    hold_at = horizon if hold_horizon == 0 else jnp.minimum(horizon, hold_horizon)
-    held = real & achieved_at_t & (hs == hold_at)[:, None, None] & hold
-    settled = jnp.zeros_like(moved)
-    if settle:
-        after = jnp.minimum(later[..., None] + jnp.arange(1, H + 1), T)  # [H, T, H] the steps after t + h
-        stays = jnp.all(within(env, traj.achieved[after], goal[:, :, None], radius), axis=2)
-        settled = (moved if rest_horizon == 0 else away) & stays
-        if rest:  # none settled at a larger h for the same step
-            settled = settled & (jnp.flip(jnp.cumsum(jnp.flip(settled, 0), 0), 0) == 1)
-        moved = settled if rest_horizon == 0 else moved | settled
-    at_final = (held | settled).reshape(-1)
-    valid, held = (moved | held).reshape(-1), held.reshape(-1)
-    goal = goal.reshape(H * T * n, -1)
-    if use_select:
+    """Algorithm 2, lines 12-19, for every explored episode at once. ``max_horizon`` fixes the shapes;
+    ``horizon`` (traced, <= max_horizon) masks larger h, so runs of different H share one program.
+    ``use_select=False`` stores every candidate (the ablation). ``lanes``: the replay batch, times the
+    T x N explored steps (speed, never a verdict). ``relabel`` names the strategy (``relabel.STRATEGIES``)."""
+    strategy, (T, H, n) = STRATEGIES[relabel], (env.episode_length, max_horizon, traj.actions.shape[1])
+    hs = hindsight(env, traj, H)  # lines 12-14: for t = 1..T, h = 1..H: g' = m(s_{t+h})
+    moved, held = strategy.candidates(hs, horizon)
+    valid, held, goal = (moved | held).reshape(-1), held.reshape(-1), hs.goal.reshape(H * T * n, -1)
+    reached, steps = jnp.zeros_like(valid), jnp.int32(0)
+    if use_select:  # line 15: SELECT(s_t, g'): does the policy, restored at s_t, reach g' within h steps?
         starts = jax.tree_util.tree_map(lambda x: x.reshape((T * n,) + x.shape[2:]), traj.states)
         flat = jnp.arange(H * T * n, dtype=jnp.int32)
-        reached, steps = replay_queue(
-            env,
-            policy,
-            pstate,
-            starts,
-            goal,
-            flat % (T * n),
-            flat // (T * n) + 1,
-            valid,
-            num_lanes(T, n, lanes, H),
-            at_final=at_final,
-            radius=radius,
-        )
-        accept = valid & ~reached
-    else:
-        accept, steps = valid, jnp.int32(0)
+        start_of, h_of, lanes = flat % (T * n), flat // (T * n) + 1, num_lanes(T, n, lanes, H)
+        reached, steps = replay_queue(env, policy, pstate, starts, goal, start_of, h_of, valid, lanes, held)
     tile = lambda x: jnp.broadcast_to(x[None], (H,) + x.shape).reshape((H * T * n,) + x.shape[2:])  # noqa: E731
-    action = tile(traj.actions)
-    if stop:
-        action = jnp.where(held[:, None], jnp.zeros_like(action), action)
-    out = Candidates(tile(traj.states.obs), goal, action, valid, accept, held, steps)
+    action = strategy.label(tile(traj.actions), held)  # line 16: store (s_t, g', a_t) where it did not
+    out = Candidates(tile(traj.states.obs), goal, action, valid, valid & ~reached, held, steps)
     chex.assert_shape([out.valid, out.accept, out.held], (num_candidates(T, H, n),))
     return out

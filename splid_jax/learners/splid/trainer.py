@@ -20,9 +20,9 @@ from splid_jax.learners.base import Chunked
 from splid_jax.learners.imitation import relabel_buffer
 from splid_jax.learners.imitation.bc import bc_epoch
 from splid_jax.learners.imitation.candidates import Candidates
-from splid_jax.learners.imitation.config import ImitationConfig, select_modes
+from splid_jax.learners.imitation.config import ImitationConfig
 from splid_jax.learners.imitation.explore import Seen, Trajectory, draws, hold_fingers, rollout
-from splid_jax.learners.splid.select import held_pairs, select
+from splid_jax.learners.splid.select import select
 
 
 @struct.dataclass
@@ -48,10 +48,17 @@ class Hyper:
     acting_step: jax.Array  # [] float32: 1 - policy_ema, taken in double as a constant's would be
     gripper_hold: jax.Array  # [] int32, steps the fingers' noise is held (tasks that move them)
     explore_reach: jax.Array  # [] float32, exploration's subgoal reach (inf: the goal itself)
-    held_share: jax.Array  # [] float32, the share of BC's batches drawn from the held-goal pairs
     bc_reuse: jax.Array  # [] float32, BC samples per new pair (0: the configured steps every iteration)
     buffer_window: jax.Array  # [] int32, BC draws from the newest this many pairs (the capacity: all)
     buffer_window_grow: jax.Array  # [] int32, iterations over which the window grows to the capacity (0: fixed)
+
+
+def optimiser(name: str, learning_rate) -> optax.GradientTransformation:
+    """Behaviour cloning's optimiser: Adam, or RMSprop as PyTorch's (decay 0.99, eps outside the root), the
+    authors' released code's."""
+    if name == "rmsprop":
+        return optax.rmsprop(learning_rate, decay=0.99, eps=1e-8, eps_in_sqrt=False)
+    return optax.adam(learning_rate)
 
 
 class Trainer(Chunked):
@@ -71,7 +78,7 @@ class Trainer(Chunked):
         self.env, self.cfg, self.bc, self.name = env, cfg, bc, cfg.algo
         self.learner = registry.get(cfg.algo)
         # shapes; a sweep's members mask larger h through Hyper.horizon
-        self.max_horizon = max(bc.horizon, bc.rest_horizon)
+        self.max_horizon = bc.horizon
         self.pchid_every = max(1, bc.pchid_every)  # TrainConfig resolves 0 for pchid
         allowed = "0 for pchid, whose horizon grows over the run"
         check(not (self.learner.grows_horizon and bc.horizon_end), "horizon_end", bc.horizon_end, allowed)
@@ -101,7 +108,6 @@ class Trainer(Chunked):
             acting_step=jnp.float32(1.0 - bc.policy_ema),
             gripper_hold=jnp.int32(bc.gripper_hold),
             explore_reach=traced_reach(bc.explore_subgoal_reach),
-            held_share=jnp.float32(bc.held_share),
             bc_reuse=jnp.float32(bc.bc_reuse),
             buffer_window=jnp.int32(bc.buffer_window or self.bc.buffer_size),
             buffer_window_grow=jnp.int32(bc.buffer_window_grow),
@@ -113,7 +119,7 @@ class Trainer(Chunked):
         env, bc = self.env, self.bc
         return TrainState(
             policy=pstate,
-            opt_state=optax.adam(bc.learning_rate).init(pstate.params),  # Adam's state is the same at any rate
+            opt_state=optimiser(bc.optimiser, bc.learning_rate).init(pstate.params),  # the same state at any rate
             online=None if bc.policy_ema == 0 else jax.tree_util.tree_map(jnp.copy, pstate.params),
             buffer=relabel_buffer.init(bc.buffer_size, env.obs_size, env.goal_size, env.action_size),
             key=k_run,
@@ -213,15 +219,9 @@ class Trainer(Chunked):
         configured bc_steps (all when None): the one place the settings become BC's arguments. Returns
         (pstate, opt_state, online, mean loss)."""
         bc = self.bc
-        optimiser = optax.adam(hyper.learning_rate)
-        held = None
-        if bc.held_share > 0 and not self.learner.clones_every_pair:  # the held pairs SELECT stored
-            held = relabel_buffer.newest(buf, hyper.buffer_window) & held_pairs(
-                self.env, buf.obs, buf.goal, bc.select_radius
-            )
         return bc_epoch(
             self.policy,
-            optimiser,
+            optimiser(bc.optimiser, hyper.learning_rate),
             pstate,
             opt_state,
             buf,
@@ -230,8 +230,6 @@ class Trainer(Chunked):
             bc.batch_size,
             online,
             hyper.acting_step,
-            held,
-            hyper.held_share,
             steps,
             hyper.buffer_window,
         )
@@ -248,10 +246,7 @@ class Trainer(Chunked):
             horizon,
             bc.select,
             bc.select_lanes,
-            radius=bc.select_radius,
-            hold_horizon=bc.hold_horizon,
-            rest_horizon=bc.rest_horizon,
-            **select_modes(bc.relabel),
+            bc.relabel,
         )
 
     def sigma_at(self, iteration: jax.Array, hyper: Hyper) -> jax.Array:

@@ -35,8 +35,6 @@ def test_every_name_builds_its_own_learner_from_its_own_settings():
         for field in registry.get(name).sweeps:
             value = getattr(cfg, field)
             changed = {field: value + 1 if isinstance(value, int) else value / 2 + 0.1}
-            if field == "held_share":  # a share of the held goals that only the holding relabellings add
-                changed["relabel"] = "hold"
             base = dataclasses.replace(cfg, buffer_window=1) if field == "buffer_window_grow" else cfg  # grows from it
             other = dataclasses.replace(base, **changed)
             same = jax.tree.map(lambda a, b: a == b, algo.hyper(other), algo.hyper(base))
@@ -60,7 +58,7 @@ def test_only_the_cloning_learners_split_a_run_and_sweep_their_settings():
     splits = {name for name, x in registry.LEARNERS.items() if x.splits_envs}
     assert splits == {"splid", "gcsl", "pchid"}
     traced = ("sigma", "horizon", "horizon_end", "sigma_end", "learning_rate", "policy_ema", "gripper_hold")
-    traced += ("explore_subgoal_reach", "held_share", "bc_reuse", "buffer_window", "buffer_window_grow")
+    traced += ("explore_subgoal_reach", "bc_reuse", "buffer_window", "buffer_window_grow")
     assert all(registry.get(n).sweeps == (traced if n in splits else ()) for n in registry.names())
     assert [n for n, x in registry.LEARNERS.items() if x.grows_horizon] == ["pchid"]
     assert [n for n, x in registry.LEARNERS.items() if x.clones_every_pair] == ["gcsl"]

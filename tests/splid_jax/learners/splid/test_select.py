@@ -30,15 +30,15 @@ def policy(env):
 
 @pytest.fixture(scope="module")
 def run_select(env, policy):
-    """``run_select(pstate, traj, horizon=H, use_select=True, lanes=1.0, **modes)``: SELECT with
-    ``select``'s keyword settings ``modes`` (hold, settle, radius, ...), jitted once per setting."""
+    """``run_select(pstate, traj, horizon=H, use_select=True, lanes=1.0, relabel="paper")``: SELECT jitted
+    once per setting."""
 
     @functools.cache
-    def jitted(use_select, lanes, modes):
-        return jax.jit(lambda ps, tr, hz: select(env, policy, ps, tr, H, hz, use_select, lanes, **dict(modes)))
+    def jitted(use_select, lanes, relabel):
+        return jax.jit(lambda ps, tr, hz: select(env, policy, ps, tr, H, hz, use_select, lanes, relabel))
 
-    def run(pstate, traj, horizon=H, use_select=True, lanes=1.0, **modes):
-        return jitted(use_select, lanes, tuple(sorted(modes.items())))(pstate, traj, jnp.int32(horizon))
+    def run(pstate, traj, horizon=H, use_select=True, lanes=1.0, relabel="paper"):
+        return jitted(use_select, lanes, relabel)(pstate, traj, jnp.int32(horizon))
 
     return run
 
@@ -166,17 +166,17 @@ def test_no_valid_candidate_means_no_replay(env, policy, run_select):
 
 
 def test_held_goals_are_kept_where_the_policy_leaves_them_and_judged_at_the_final_step(env, policy, run_select):
-    """``hold``: a point that stayed put (explored action 0) holds its goal for H steps; a policy that
+    """``relabel=hold``: a point that stayed put (explored action 0) holds its goal for H steps; a policy that
     drifts +x leaves it (keep the pair), one that stays holds it too (reject). Only h = H is a held
     candidate, and the verdict is the final step's: a policy that passes through g' still fails."""
     traj = scripted_trajectory(env, [], start=(-2.0, -4.8))
     hs, ts = np.arange(1, H + 1)[:, None, None], np.arange(T)[None, :, None]
     drift, stay = constant_policy(policy, [1.0, 0.0]), constant_policy(policy, [0.0, 0.0])
-    kept = run_select(drift, traj, hold=True)
+    kept = run_select(drift, traj, relabel="hold")
     np.testing.assert_array_equal(env_of(kept.held), np.broadcast_to((hs == H) & (ts + hs <= T), (H, T, N)))
     np.testing.assert_array_equal(kept.accept, kept.held)
     assert int(kept.replay_steps) == H * int(kept.held.sum())  # held replays run their full H
-    assert not np.asarray(run_select(stay, traj, hold=True).accept).any()
+    assert not np.asarray(run_select(stay, traj, relabel="hold").accept).any()
     assert not np.asarray(run_select(drift, traj).valid).any()  # paper: none
     # a policy that crosses g' and comes back within the success radius only at some middle step
     goal = traj.achieved[0, 0]
@@ -186,28 +186,11 @@ def test_held_goals_are_kept_where_the_policy_leaves_them_and_judged_at_the_fina
     )
 
 
-def test_hold_horizon_judges_the_held_goals_that_many_steps_on(env, policy, run_select):
-    """``hold_horizon=2``: the held candidates are those at h = 2 (at most the horizon), each replayed
-    2 steps; the moved ones are untouched. Above the run's horizon it falls back to H."""
-    traj = scripted_trajectory(env, [[0.0, 0.4]], start=(-2.0, -4.8))  # env 0 moves, the others stand still
-    hs, ts = np.arange(1, H + 1)[:, None, None], np.arange(T)[None, :, None]
-    drift = constant_policy(policy, [1.0, 0.0])
-    full, short = run_select(drift, traj, hold=True), run_select(drift, traj, hold=True, hold_horizon=2)
-    standing = env_of(short.held)[..., 1:]
-    np.testing.assert_array_equal(standing, np.broadcast_to((hs == 2) & (ts + hs <= T), standing.shape))
-    np.testing.assert_array_equal(short.accept, short.held | (np.asarray(full.accept) & ~np.asarray(full.held)))
-    assert int(short.held.sum()) > int(full.held.sum())  # h = 2 fits more steps before the episode's end
-    moved = np.asarray(full.valid) & ~np.asarray(full.held)
-    assert moved.any() and int(short.replay_steps) < int(full.replay_steps)
-    np.testing.assert_array_equal(run_select(drift, traj, 3, hold=True, hold_horizon=4).held, run_select(
-        drift, traj, 3, hold=True).held)
-
-
 def test_stop_labels_the_held_pairs_with_the_zero_action_and_keeps_the_rest(env, policy, run_select):
-    """``stop``: the same verdicts as ``hold``; the held pairs' action becomes 0, the moved ones keep theirs."""
+    """``relabel=stop``: the same verdicts as ``hold``; the held pairs' action becomes 0, the moved ones keep theirs."""
     traj = scripted_trajectory(env, [[0.0, 0.4]], start=(-2.0, -4.8))  # env 0 moves, the others stand still
     drift = constant_policy(policy, [1.0, 0.0])
-    held, stopped = run_select(drift, traj, hold=True), run_select(drift, traj, hold=True, stop=True)
+    held, stopped = run_select(drift, traj, relabel="hold"), run_select(drift, traj, relabel="stop")
     np.testing.assert_array_equal(stopped.accept, held.accept)
     np.testing.assert_array_equal(stopped.held, held.held)
     h, action = np.asarray(held.held), np.asarray(stopped.action)
@@ -215,60 +198,3 @@ def test_stop_labels_the_held_pairs_with_the_zero_action_and_keeps_the_rest(env,
     np.testing.assert_array_equal(action[h], 0.0)
     np.testing.assert_array_equal(action[~h], np.asarray(held.action)[~h])
     assert np.abs(np.asarray(held.action)[np.asarray(held.valid) & ~h]).max() > 0
-
-
-def test_settle_keeps_moved_goals_where_the_object_then_stays_and_radius_scales_the_threshold(
-    env, policy, run_select
-):
-    """0.3 per step in y: a goal is 'reached' once the point moved more than the radius (1.0: h >= 4;
-    0.5: h >= 2). ``settle`` keeps a moved goal only where the point then stays within the radius of
-    it for H steps or to the episode's end (0.3 per step leaves 1.0 after 4 steps: only t + h >= T - 3),
-    and replays every kept candidate its full h (verdict at the final step)."""
-    traj = scripted_trajectory(env, [[0.0, 0.3]])
-    drift = constant_policy(policy, [1.0, 0.0])  # never at a goal up the y axis
-    hs, ts = np.arange(1, H + 1)[:, None], np.arange(T)[None, :]
-    paper = (hs >= 4) & (ts + hs <= T)
-    np.testing.assert_array_equal(env_of(run_select(drift, traj).valid)[..., 0], paper)
-    near = env_of(run_select(drift, traj, radius=0.5).valid)[..., 0]
-    np.testing.assert_array_equal(near, (hs >= 2) & (ts + hs <= T))
-    settled = run_select(drift, traj, hold=True, settle=True)
-    want = paper & (ts + hs >= T - 3)
-    np.testing.assert_array_equal(env_of(settled.valid)[..., 0], want)
-    np.testing.assert_array_equal(settled.accept, settled.valid)
-    # every kept candidate, moved or held (the standing-still envs' h = H ones), runs its full h
-    assert int(settled.replay_steps) == int((hs[..., None] * env_of(settled.valid)).sum()) > int((hs * want).sum())
-
-
-def test_rest_keeps_one_settled_goal_per_step_the_latest(env, policy, run_select):
-    """``rest``: of the settle test's candidates (t + h >= T - 3, h >= 4) each step t keeps only its
-    largest h, so a step asks once where the object came to rest; held candidates are unchanged."""
-    traj = scripted_trajectory(env, [[0.0, 0.3]])
-    drift = constant_policy(policy, [1.0, 0.0])
-    hs, ts = np.arange(1, H + 1)[:, None], np.arange(T)[None, :]
-    settled = run_select(drift, traj, hold=True, settle=True)
-    once = run_select(drift, traj, hold=True, settle=True, rest=True)
-    want = (hs >= 4) & (ts + hs >= T - 3) & (ts + hs <= T)
-    latest = want & (hs == np.minimum(H, T - ts))
-    assert latest.any() and (want & ~latest).any()
-    np.testing.assert_array_equal(env_of(once.valid)[..., 0], latest)
-    np.testing.assert_array_equal(once.held, settled.held)
-    np.testing.assert_array_equal(once.accept, once.valid)
-
-
-def test_rest_horizon_adds_resting_places_beyond_the_horizon_to_algorithm_2s_goals(env, policy, run_select):
-    """``rest_horizon=5`` at horizon 3 (radius 0.5: a goal is away from h = 2 on): Algorithm 2's
-    candidates within 3 steps, and each step's latest resting place within 5, every one of them
-    replayed its full h by a policy that never gets there; held goals at h = 3."""
-    traj = scripted_trajectory(env, [[0.0, 0.3]])
-    drift = constant_policy(policy, [1.0, 0.0])
-    paper = run_select(drift, traj, horizon=3, radius=0.5)
-    rested = run_select(drift, traj, hold=True, settle=True, rest=True, radius=0.5)
-    both = run_select(drift, traj, horizon=3, hold=True, settle=True, rest=True, rest_horizon=5, radius=0.5)
-    moved = lambda c: env_of(np.asarray(c.valid) & ~np.asarray(c.held))[..., 0]  # noqa: E731
-    want = moved(paper) | moved(rested)
-    assert (want & ~moved(paper)).any() and (want & ~moved(rested)).any()
-    np.testing.assert_array_equal(moved(both), want)
-    np.testing.assert_array_equal(both.held, run_select(drift, traj, horizon=3, hold=True, radius=0.5).held)
-    np.testing.assert_array_equal(both.accept, both.valid)
-    hs = np.arange(1, H + 1)[:, None, None]
-    assert int(both.replay_steps) == int((hs * env_of(both.valid)).sum())

@@ -111,32 +111,6 @@ def test_subgoals_change_the_evaluation_and_nothing_the_training_does(trainer):
     assert float(plain["eval_return"]) != float(steered["eval_return"])
 
 
-def test_a_held_share_clones_the_held_pairs_that_select_stored():
-    """BC's batches at held_share 1 come from the buffer's held pairs alone (the one pair here whose
-    goal is where the point already is), at 0 from every pair."""
-    env = envs.make("point")
-    cfg = TrainConfig(**{**CFG, "relabel": "hold", "buffer_size": 64, "bc_steps": 1, "held_share": 0.5})
-    trainer = Trainer(env, cfg)
-    ts = trainer.init(jax.random.PRNGKey(0))
-    obs = jax.random.uniform(jax.random.PRNGKey(1), (40, env.obs_size), minval=-1.0, maxval=1.0)
-    start = env.achieved_goal_start
-    goal = obs[:, start : start + env.goal_size] + 2 * env.success_distance  # moved goals, beyond success
-    goal = goal.at[7].set(obs[7, start : start + env.goal_size])  # one held pair
-    action = jax.random.uniform(jax.random.PRNGKey(2), (40, env.action_size), minval=-1.0, maxval=1.0)
-    buf = relabel_buffer.insert(ts.buffer, obs, goal, action, jnp.ones(40, bool))
-    clone = jax.jit(trainer.clone)
-    key = jax.random.PRNGKey(3)
-
-    def loss(share):
-        hyper = trainer.hyper().replace(held_share=jnp.float32(share))
-        return float(clone(ts.policy, ts.opt_state, ts.online, buf, key, hyper)[-1])
-
-    params = ts.policy.params if ts.online is None else ts.online
-    on_held = float(bc_loss(params, trainer.policy, ts.policy, obs[7:8], goal[7:8], action[7:8]))
-    np.testing.assert_allclose(loss(1.0), on_held, rtol=1e-5)
-    assert abs(loss(0.0) - on_held) > 1e-3
-
-
 def test_bc_reuse_sets_the_steps_by_the_pairs_stored_and_is_a_traced_setting(trainer):
     """bc_reuse x new pairs / batch_size minibatches, in [1, bc_steps]; 0 keeps bc_steps (50 here)."""
     iteration = jax.jit(trainer.iteration)
