@@ -212,3 +212,37 @@ def test_splid_on_push_clones_a_window_widening_to_200k_pairs_and_the_baselines_
     assert (resumed.buffer_size, resumed.buffer_window, resumed.buffer_window_grow) == (50_000, 0, 0)
     assert not {"buffer_window", "buffer_window_grow"} & set(identity(resumed))
     assert identity(TrainConfig(env="push"))["buffer_window_grow"] == 200
+
+
+# config.json as the version before presets wrote it (flat, with the options since retired at their neutral values)
+OLD_CONFIG = {
+    "env": "point", "seed": 0, "iterations": 5, "num_envs": 8, "sigma": 1.0, "sigma_end": 1.0, "sigma_anneal": 1,
+    "horizon": 8, "horizon_end": 0, "gripper_hold": 1, "explore_subgoal_reach": 0.0, "hold_horizon": 0,
+    "rest_horizon": 0, "algo": "splid", "select": True, "relabel": "paper", "select_radius": 1.0,
+    "gcsl_relabel": "final", "pchid_every": 0, "select_lanes": 1.0, "held_share": 0.0, "buffer_size": 200000,
+    "buffer_window": 0, "buffer_window_grow": 0, "batch_size": 256, "bc_steps": 10, "bc_reuse": 0.0,
+    "learning_rate": 0.001, "policy_ema": 0.0, "hidden": [64, 64, 64], "normalise": True, "relative_goal": False,
+    "eval_every": 5, "eval_episodes": 8, "eval_subgoal_reach": 0.0, "checkpoint_every": 1, "num_devices": 1,
+    "run_dir": "runs/old", "env_options": "", "her_options": "", "es_options": "", "devices": ["cpu:0"],
+}  # fmt: skip
+
+
+def test_an_old_config_json_loads_and_resumes_as_it_ran(tmp_path):
+    from splid_jax.runtime.run_files import identity
+    from splid_jax.train import build_parser, config_from_cli
+
+    cfg = TrainConfig.from_json(OLD_CONFIG)
+    now = TrainConfig(env="point", iterations=5, num_envs=8, eval_episodes=8, bc_steps=10, run_dir="runs/old")
+    assert cfg == now and (cfg.preset, cfg.optimiser) == ("tuned", "adam")
+    record = identity(cfg)  # what its checkpoint must hold: nothing the old version did not record as such
+    assert record and all(k in OLD_CONFIG and OLD_CONFIG[k] == v for k, v in record.items())
+    her = TrainConfig.from_json({**OLD_CONFIG, "algo": "her", "her_options": "batch_size=64,hidden=32,32"})
+    assert (her.learner_config().batch_size, her.learner_config().hidden) == (64, (32, 32))
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "config.json").write_text(json.dumps({**OLD_CONFIG, "run_dir": str(run)}))
+    resumed, is_resume = config_from_cli(build_parser().parse_args(["--resume", str(run), "--iterations", "10"]))
+    assert is_resume and resumed == dataclasses.replace(now, iterations=10, run_dir=str(run))
+    for name, value in (("select_radius", 0.8), ("relabel", "settle"), ("held_share", 0.1)):
+        with pytest.raises(InvalidConfig, match=name):
+            TrainConfig.from_json({**OLD_CONFIG, name: value})
