@@ -118,6 +118,7 @@ PAPER_SOURCES: dict[str, tuple[Any, str]] = {
     "bc_reuse": (30.0, "ESPD: --num-epoch 30 x new pairs / minibatch steps per iteration"),
     "bc_steps": (5_000, "a cap ESPD does not have: reached above 4,166 new pairs in an iteration"),
     "num_envs": (50, "ESPD: --batch-size 2,500 steps per iteration, 50 episodes of 50 steps"),
+    "env_options": ("", "paper: the tasks' own starts (tuned PickAndPlace's grasped starts are HER's protocol)"),
 }
 PAPER_SPLID = {name: value for name, (value, _) in PAPER_SOURCES.items()}
 # HER's paper preset is OpenAI Baselines' DDPG+HER (HerConfig's BASELINES), whose curves ran 8 MPI workers of 2
