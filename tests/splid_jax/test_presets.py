@@ -11,6 +11,7 @@ import envs
 from splid_jax import presets
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
+from splid_jax.learners.her.config import BASELINES, HerConfig
 from splid_jax.learners.imitation.config import RELABELS
 from splid_jax.learners.splid import relabel
 
@@ -66,8 +67,14 @@ def test_the_paper_preset_of_each_baseline():
     assert gcsl.gcsl_relabel == "final" and pchid.pchid_every == 200 // (2 * 8)  # H grows 1..8 over half the run
     ablation = TrainConfig(env="push", preset="paper", select=False)  # SPLID without SELECT
     assert resolved(ablation) == {**PAPER, "select": False}
-    her = TrainConfig(env="push", algo="her", preset="paper")  # OpenAI Baselines: 2 episodes x 8 workers a cycle
-    assert (her.num_envs, her.eval_every, her.iterations) == (16, 50, 1250)
+    her = TrainConfig(env="pick_and_place", algo="her", preset="paper")  # Baselines: 2 episodes x 8 workers a cycle
+    assert (her.num_envs, her.eval_every, her.iterations, her.env_options) == (16, 50, 3200, "")
+    assert her.learner_config() == HerConfig(**BASELINES)
+    mrl = TrainConfig(env="pick_and_place", algo="her")  # the tuned HER: mrl's
+    assert (mrl.num_envs, mrl.eval_every, mrl.iterations, mrl.learner_config()) == (8, 25, 2500, HerConfig())
+    given = TrainConfig(env="push", algo="her", preset="paper", her_options="hidden=512,512,512")
+    assert given.learner_config() == HerConfig(**{**BASELINES, "hidden": (512, 512, 512)})
+    assert TrainConfig.from_json(given.to_json()) == given  # its recorded options read the same again
     es = TrainConfig(env="push", algo="es", preset="paper")
     assert es.learner_config() == TrainConfig(env="push", algo="es").learner_config()  # Salimans et al.'s
 
