@@ -110,12 +110,12 @@ def flag_error(err, parser: argparse.ArgumentParser) -> str:
         return f"{flag(match[1])} {match[2]}" if flag(match[1]) else match[0]
 
     def typed(text: str) -> str:
-        text = re.sub(r"\b([a-z][a-z0-9]*(?:[._][a-z0-9]+)*)=([^\s,;()]+)", named, text)
-        return re.sub(r"\b[a-z][a-z0-9]*(?:_[a-z0-9]+)+\b", lambda m: flag(m[0]) or m[0], text)
+        return re.sub(r"\b([a-z][a-z0-9]*(?:[._][a-z0-9]+)*)=([^\s,;()]+)", named, text)
 
     if str(err) != f"invalid {err.field}={err.value!r}: must be {err.allowed}":  # a message of its own
         return typed(str(err))
     value = ",".join(map(str, err.value)) if isinstance(err.value, tuple | list) else err.value
+    value = "(unset)" if value is None else value
     head = f"{flag(err.field)} {value}" if flag(err.field) else f"{err.field}={err.value!r}"
     return f"invalid {head}: must be {typed(err.allowed)}"
 
@@ -163,6 +163,11 @@ def _int_tuple(text: str) -> tuple[int, ...]:
 _TYPES = {"int": int, "float": float, "str": str, "str | None": str, "tuple[int, ...]": _int_tuple}
 
 
+def settings_of(cls) -> tuple[dataclasses.Field, ...]:
+    """A config dataclass's settings as its flags name them (``TrainConfig``'s flat, with the cloning ones)."""
+    return cls.settings_fields() if hasattr(cls, "settings_fields") else dataclasses.fields(cls)
+
+
 def add_config_flags(
     parser: argparse.ArgumentParser,
     cls,
@@ -174,7 +179,7 @@ def add_config_flags(
     apart. ``per_algo``: a learner's own defaults per task, shown after the task defaults they replace.
     Fields that only some learners read are listed in a group per set of learners (``readers``)."""
     groups: dict[str, argparse._ArgumentGroup] = {}
-    for f in dataclasses.fields(cls):
+    for f in settings_of(cls):
         if f.name in exclude:
             continue
         flag = "--" + f.name.replace("_", "-")
@@ -237,7 +242,7 @@ def add_learner_flags(parser: argparse.ArgumentParser) -> None:
 def explicit_values(cls, namespace: argparse.Namespace) -> dict:
     """The settings given on the command line; a learner's own flags (``add_learner_flags``) join its
     options text, after those ``--her-options`` gives."""
-    names = {f.name for f in dataclasses.fields(cls)}
+    names = {f.name for f in settings_of(cls)}
     given = {k: v for k, v in vars(namespace).items() if k in names and v is not None}
     for key, value in vars(namespace).items():
         options, _, name = key.partition(":")

@@ -1,9 +1,10 @@
 """A run's configuration: one frozen dataclass, validated on construction, from which the command
 line is generated (each field's ``help`` is its ``--help`` line) and which a run's config.json holds.
 
-It is flat: the run's own settings (task, seed, budget, evaluation, checkpoints, devices) beside every
-learner's. Each learner reads its own as a frozen dataclass of its own (``learner_config``, through
-``learners.registry``); a field that the chosen learner does not read is refused on the command line."""
+Its fields are the run's own settings (task, seed, budget, evaluation, checkpoints, devices) and each
+learner's own as a frozen dataclass of their own (``cloning``) or options text (HER's, ES's). The command
+line and config.json hold them flat, one level; ``presets`` gives those left unset; a setting that the
+chosen learner does not read is refused on the command line."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import dataclasses
 import math
 import numbers
 import os
+import types
 from typing import Any
 
 import envs
@@ -20,7 +22,9 @@ from splid_jax.common.fields import field
 from splid_jax.common.paths import is_utf8
 from splid_jax.common.values import format_overrides, merged_options, options_text, parse_options, parse_overrides
 from splid_jax.learners import registry
+from splid_jax.learners.imitation.config import ImitationConfig
 
+CLONING = frozenset(f.name for f in dataclasses.fields(ImitationConfig))
 MAX_ITERATIONS = 10**7  # far beyond any run's budget: a larger value is a typo, and would run for ever
 # Keys a run's config.json holds beside the fields: where it ran, and which defaults its learner's options
 # are read against (HER's defaults were Baselines' before they became mrl's).
@@ -56,8 +60,12 @@ def _is_a(value: Any, kind: str) -> bool:
     return True
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, init=False)
 class TrainConfig:
+    """Built from the settings flat (``TrainConfig(env="push", horizon=8)``), as the command line and
+    config.json give them: the run's own are its fields, the cloning learners' go to ``cloning`` (read
+    also as ``cfg.horizon``), HER's and ES's travel as options text."""
+
     env: str = field("point", "task: " + ", ".join(envs.names()))
     preset: str = field(
         "tuned",
@@ -75,106 +83,7 @@ class TrainConfig:
         "episodes explored in parallel per iteration; es: not set, its population plays "
         "es.population x es.episodes_per_member episodes per generation",
     )
-    sigma: float = field(1.0, "std of the Gaussian exploration noise added to the policy's action")
-    sigma_end: float = field(
-        None,
-        "exploration noise at the end of its annealing, as a fraction of sigma: the std falls linearly from "
-        "sigma to sigma_end x sigma over the first sigma_anneal iterations (1: constant)",
-    )
-    sigma_anneal: int = field(
-        None, "iterations over which sigma anneals to sigma_end x sigma, which it keeps from then on"
-    )
-    horizon: int = field(None, "learning horizon H: hindsight goals come from 1..H steps ahead")
-    horizon_end: int = field(
-        None,
-        "splid: the learning horizon at the end of the noise's annealing: H falls linearly to horizon_end over "
-        "the first sigma_anneal iterations, so long horizons speed early learning and short ones judge the "
-        "final approach (0: H throughout; with --horizon given and this not, 0)",
-        recorded_when_set=True,
-        unrecorded=0,
-    )
-    gripper_hold: int = field(
-        1,
-        "pick_and_place: steps for which the exploration noise on the fingers' open/close command is held "
-        "before it is drawn again (1: afresh every step, as the arm's), so a grasp met by chance lasts long "
-        "enough for the arm's noise to lift the object",
-        recorded_when_set=True,
-    )
-    explore_subgoal_reach: float = field(
-        None,
-        "splid, gcsl, pchid: exploration acts towards a subgoal on the line to the goal at most this far from the "
-        "achieved goal (m on the Fetch tasks), as evaluations do with eval_subgoal_reach; relabelling and SELECT "
-        "are unchanged. 0: the goal itself",
-        recorded_when_set=True,
-        unrecorded=0.0,
-    )
     algo: str = field("splid", "learner: " + ", ".join(f"{x.name} ({x.summary})" for x in registry.LEARNERS.values()))
-    select: bool = field(True, "SELECT by first hit time; --no-select stores every relabelled pair (ablation)")
-    relabel: str = field(
-        None,
-        "splid/pchid candidates: paper (Algorithm 2 exactly), hold (also steps whose goal is already "
-        "achieved and held for H steps, kept when the policy is not at the goal after H steps) or stop "
-        "(hold, with the held pairs labelled by the zero action: stand still at a reached goal)",
-    )
-    gcsl_relabel: str = field(
-        "final", "gcsl: the later goal each step is paired with: final (the episode's last) or future (uniform)"
-    )
-    pchid_every: int = field(
-        0,
-        "pchid: iterations per horizon step; the horizon is min(H, 1 + iteration // pchid_every), "
-        "0 picks pchid_every so that H is reached half-way through the run",
-    )
-    select_lanes: float = field(
-        None,
-        "parallel SELECT replay lanes per T x N explored steps, up to H (speed only, never a verdict): above 1 "
-        "an explored step's candidates replay side by side in fewer rounds (a GPU steps a wider batch in little "
-        "more time, up to a point)",
-    )
-    buffer_size: int = field(None, "relabel buffer capacity (FIFO)")
-    buffer_window: int = field(
-        None,
-        "cloning learners: behaviour cloning draws from the newest buffer_window pairs alone, as a FIFO buffer of "
-        "that capacity would hold them; a traced setting, so one sweep compares buffer capacities up to "
-        "buffer_size (0: the whole buffer; with buffer_size given and this not, 0)",
-        recorded_when_set=True,
-        unrecorded=0,
-    )
-    buffer_window_grow: int = field(
-        None,
-        "cloning learners, with buffer_window: the window grows linearly from buffer_window to the whole buffer "
-        "over the first buffer_window_grow iterations, so the start clones the newest pairs and a long run keeps "
-        "the learning phase's; a traced setting (0: fixed; with buffer_size or buffer_window given and this not, 0)",
-        recorded_when_set=True,
-        unrecorded=0,
-    )
-    batch_size: int = field(None, "behaviour-cloning minibatch size")
-    bc_steps: int = field(None, "behaviour-cloning gradient steps per iteration (with bc_reuse: at most)")
-    bc_reuse: float = field(
-        None,
-        "cloning learners: behaviour-cloning samples per newly stored pair, so an iteration runs ceil(bc_reuse x new "
-        "pairs / batch_size) steps, at least 1 and at most bc_steps; SELECT keeps fewer pairs as the policy improves, "
-        "and a fixed step count then trains ever longer on the same pairs (the authors' code: 30 samples per new "
-        "pair). 0: bc_steps every iteration",
-        recorded_when_set=True,
-        unrecorded=0.0,
-    )
-    learning_rate: float = field(None, "learning rate of the behaviour-cloning step")
-    optimiser: str = field(
-        None, "behaviour cloning's optimiser: adam or rmsprop (PyTorch's, the authors' code's)",
-        recorded_when_set=True, unrecorded="adam",
-    )  # fmt: skip
-    policy_ema: float = field(
-        None,
-        "Polyak average of the cloned parameters that acts (explore, SELECT, eval): "
-        "acting = d * acting + (1 - d) * cloned after each BC step; 0 acts with the cloned ones",
-    )
-    hidden: tuple[int, ...] = field(
-        None, "hidden layer widths of the policy MLP, e.g. 64,64,64 (her: see --her-options hidden)"
-    )
-    normalise: bool = field(None, "normalise policy inputs with running mean and std")
-    relative_goal: bool = field(
-        None, "also feed the policy the goal minus the achieved goal (read off the observation), not only both"
-    )
     eval_every: int = field(None, "iterations per compiled chunk; evaluation, logging and checkpoints come between")
     eval_episodes: int = field(None, "episodes of the deterministic policy per evaluation")
     eval_subgoal_reach: float = field(
@@ -201,6 +110,7 @@ class TrainConfig:
         "the keys given replace the task's default options, the others stay (grasped_starts=0 turns "
         "pick_and_place's grasped training starts off)",
     )
+    cloning: ImitationConfig = field(None, "the cloning learners' settings, given flat (ImitationConfig's fields)")
     her_options: str = field(
         "", "her only: HER's settings as KEY=VALUE[,KEY=VALUE...], as the --her-* flags give them to config.json"
     )
@@ -208,84 +118,33 @@ class TrainConfig:
         "", "es only: ES's settings as KEY=VALUE[,KEY=VALUE...], as the --es-* flags give them to config.json"
     )
 
-    def __post_init__(self):
-        for f in dataclasses.fields(self):  # a config.json may hold any JSON: each value's type first
-            value = getattr(self, f.name)
-            check(value is None or _is_a(value, f.type), f.name, value, _KINDS.get(f.type, f.type))
-        check(self.env in envs.names(), "env", self.env, "one of " + ", ".join(envs.names()))
-        learner = registry.get(self.algo)
-        for other in registry.LEARNERS.values():  # each learner's own settings, refused for another
-            text = getattr(self, other.options) if other.options else ""
-            check(not text or other is learner, other.options, text, f"empty unless algo={other.name}")
-        if learner.sets_num_envs:  # ES: the population sets the episodes per generation
-            es = self.learner_config()
-            per_generation = es.population * es.episodes_per_member
-            check(
-                self.num_envs in (None, per_generation),
-                "num_envs",
-                self.num_envs,
-                f"unset with algo=es: its population plays es.population x es.episodes_per_member = "
-                f"{per_generation} episodes per generation",
-            )
-            object.__setattr__(self, "num_envs", per_generation)
-        check(self.preset in presets.PRESETS, "preset", self.preset, "one of " + ", ".join(presets.PRESETS))
-        defaults = presets.defaults(self.env, learner.name, self.preset)
-        options = {  # option by option: the preset's, then the given ones (their syntax is checked here, the
-            # fields where the task is built)
-            **parse_overrides(defaults.pop("env_options", "")),
-            **parse_overrides(self.env_options or ""),
-        }
-        object.__setattr__(self, "env_options", format_overrides(options))
-        if defaults.get(learner.options or ""):  # the preset's own settings of the learner, the given ones on top
-            text = merged_options(learner.settings, defaults.pop(learner.options), getattr(self, learner.options),
-                                  learner.options, learner.name)  # fmt: skip
-            object.__setattr__(self, learner.options, text)
-        if self.horizon_end is None:  # a task's falling horizon goes with its own H, not with one the caller set
-            task_end = defaults["horizon_end"] if self.horizon is None else 0
-            object.__setattr__(self, "horizon_end", task_end if registry.reads(learner.name, "horizon_end") else 0)
-        if self.buffer_size is not None or self.buffer_window is not None:  # a task's window goes with its buffer
-            for name in ("buffer_window", "buffer_window_grow"):
-                if getattr(self, name) is None:
-                    object.__setattr__(self, name, 0)
-        if not registry.reads(learner.name, "explore_subgoal_reach"):  # a task's steering is its cloning learners'
-            defaults["explore_subgoal_reach"] = 0.0
-        if not registry.reads(learner.name, "buffer_window"):  # as the window, which HER and ES do not read
-            defaults.update(buffer_window=0, buffer_window_grow=0)
-        for name, value in defaults.items():  # fill per-algorithm, then per-task defaults for fields left at None
-            if getattr(self, name) is None:
-                object.__setattr__(self, name, value)
-        object.__setattr__(self, "hidden", tuple(int(w) for w in self.hidden))
-        check(0 <= self.seed < 2**32, "seed", self.seed, "an integer in [0, 2**32)")
-        for f in dataclasses.fields(self):  # inf and nan pass every range check, and JSON cannot hold them
-            if f.type == "float":
-                check(math.isfinite(getattr(self, f.name)), f.name, getattr(self, f.name), "a finite number")
-            if f.type == "bool":  # a string such as "False" would pass every truth test
-                check(isinstance(getattr(self, f.name), bool), f.name, getattr(self, f.name), "true or false")
-        in_range = 1 <= self.iterations <= MAX_ITERATIONS
-        check(in_range, "iterations", self.iterations, f"an integer in [1, {MAX_ITERATIONS}]")
-        check(self.num_envs >= 1, "num_envs", self.num_envs, "an integer >= 1")
-        check(self.num_devices >= 0, "num_devices", self.num_devices, "an integer >= 0 (0: every device)")
-        check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "hidden", self.hidden, "one or more widths >= 1")
-        check(self.horizon >= 1, "horizon", self.horizon, "an integer >= 1 (and < the episode length)")
-        self.learner_config()  # the learner's own settings, each checked against its range
-        if learner.grows_horizon and self.pchid_every == 0:  # resolved once, so a resume keeps the schedule
-            object.__setattr__(self, "pchid_every", max(1, self.iterations // (2 * self.horizon)))
-        check(self.eval_every >= 1, "eval_every", self.eval_every, "an integer >= 1")
-        check(
-            self.iterations % self.eval_every == 0,
-            "iterations",
-            self.iterations,
-            f"a multiple of eval_every={self.eval_every}",
-        )
-        check(self.eval_episodes >= 1, "eval_episodes", self.eval_episodes, "an integer >= 1")
-        reach = self.eval_subgoal_reach
-        check(reach >= 0, "eval_subgoal_reach", reach, "a distance >= 0 (0: no subgoals)")
-        check(self.checkpoint_every >= 0, "checkpoint_every", self.checkpoint_every, "an integer >= 0")
-        if self.run_dir is None:
-            object.__setattr__(self, "run_dir", os.path.join("runs", f"{self.env}-s{self.seed}"))
-        check(self.run_dir.strip() != "", "run_dir", self.run_dir, "a directory name, not empty")
-        check(is_utf8(self.run_dir), "run_dir", self.run_dir, "a path of UTF-8 text (checkpoints are written by it)")
-        check(not os.path.isfile(self.run_dir), "run_dir", self.run_dir, "a directory, not an existing file")
+    def __init__(self, **settings):
+        cloning = settings.pop("cloning", None)  # as dataclasses.replace passes it, beside any flat changes
+        if cloning is not None:
+            settings = {**{f.name: getattr(cloning, f.name) for f in dataclasses.fields(cloning)}, **settings}
+        unknown = sorted(set(settings) - {f.name for f in self.settings_fields()})
+        if unknown:
+            raise TypeError(f"TrainConfig got unknown settings: {', '.join(unknown)}")
+        flat = types.SimpleNamespace(**{f.name: settings.get(f.name, f.default) for f in self.settings_fields()})
+        _resolve(flat)
+        for f in dataclasses.fields(self):
+            if f.name != "cloning":
+                object.__setattr__(self, f.name, getattr(flat, f.name))
+        object.__setattr__(self, "cloning", ImitationConfig(**{name: getattr(flat, name) for name in CLONING}))
+
+    def __getattr__(self, name: str):
+        """The cloning learners' settings read as the run's (``cfg.horizon``), as the command line names them."""
+        cloning = self.__dict__.get("cloning")
+        if cloning is None or name not in CLONING:
+            raise AttributeError(name)
+        return getattr(cloning, name)
+
+    @classmethod
+    def settings_fields(cls) -> tuple[dataclasses.Field, ...]:
+        """Every setting as the command line and config.json hold them: the run's and, flat, the cloning ones."""
+        run = [f for f in dataclasses.fields(cls) if f.name != "cloning"]
+        at = next(i for i, f in enumerate(run) if f.name == "eval_every")
+        return (*run[:at], *dataclasses.fields(ImitationConfig), *run[at:])
 
     def env_overrides(self) -> dict[str, Any]:
         return parse_overrides(self.env_options)
@@ -308,7 +167,8 @@ class TrainConfig:
         check(ok, "gripper_hold", self.gripper_hold, allowed)
 
     def to_json(self) -> dict[str, Any]:
-        saved = dataclasses.asdict(self)
+        """The settings flat, as config.json holds them."""
+        saved = {f.name: getattr(self, f.name) for f in self.settings_fields()}
         if self.algo == "her":
             saved["her_defaults"] = HER_DEFAULTS
         return saved
@@ -316,7 +176,7 @@ class TrainConfig:
     @classmethod
     def unrecorded_values(cls) -> dict[str, Any]:
         """What each setting added after runs were recorded reads as for those runs: how they behaved."""
-        return {f.name: f.metadata["unrecorded"] for f in dataclasses.fields(cls) if "unrecorded" in f.metadata}
+        return {f.name: f.metadata["unrecorded"] for f in cls.settings_fields() if "unrecorded" in f.metadata}
 
     @classmethod
     def from_json(cls, saved: dict[str, Any], **changes) -> TrainConfig:
@@ -336,6 +196,88 @@ class TrainConfig:
         if isinstance(options, str):  # checked by the construction above
             object.__setattr__(cfg, "env_options", options)
         return cfg
+
+
+def _resolve(c) -> None:
+    """Resolves a config's settings (``c``, flat and mutable) in place: the preset's defaults for those left
+    at None, then every check, each naming its setting."""
+    for f in TrainConfig.settings_fields():  # a config.json may hold any JSON: each value's type first
+        value = getattr(c, f.name)
+        check(value is None or _is_a(value, f.type), f.name, value, _KINDS.get(f.type, f.type))
+    check(c.env in envs.names(), "env", c.env, "one of " + ", ".join(envs.names()))
+    learner = registry.get(c.algo)
+    for other in registry.LEARNERS.values():  # each learner's own settings, refused for another
+        text = getattr(c, other.options) if other.options else ""
+        check(not text or other is learner, other.options, text, f"empty unless algo={other.name}")
+    if learner.sets_num_envs:  # ES: the population sets the episodes per generation
+        es = registry.settings(c)
+        per_generation = es.population * es.episodes_per_member
+        check(
+            c.num_envs in (None, per_generation),
+            "num_envs",
+            c.num_envs,
+            f"unset with algo=es: its population plays es.population x es.episodes_per_member = "
+            f"{per_generation} episodes per generation",
+        )
+        c.num_envs = per_generation
+    check(c.preset in presets.PRESETS, "preset", c.preset, "one of " + ", ".join(presets.PRESETS))
+    defaults = presets.defaults(c.env, learner.name, c.preset)
+    options = {  # option by option: the preset's, then the given ones (their syntax is checked here, the
+        # fields where the task is built)
+        **parse_overrides(defaults.pop("env_options", "")),
+        **parse_overrides(c.env_options or ""),
+    }
+    c.env_options = format_overrides(options)
+    if defaults.get(learner.options or ""):  # the preset's own settings of the learner, the given ones on top
+        text = merged_options(learner.settings, defaults.pop(learner.options), getattr(c, learner.options),
+                              learner.options, learner.name)  # fmt: skip
+        setattr(c, learner.options, text)
+    if c.horizon_end is None:  # a task's falling horizon goes with its own H, not with one the caller set
+        task_end = defaults["horizon_end"] if c.horizon is None else 0
+        c.horizon_end = task_end if registry.reads(learner.name, "horizon_end") else 0
+    if c.buffer_size is not None or c.buffer_window is not None:  # a task's window goes with its buffer
+        for name in ("buffer_window", "buffer_window_grow"):
+            if getattr(c, name) is None:
+                setattr(c, name, 0)
+    if not registry.reads(learner.name, "explore_subgoal_reach"):  # a task's steering is its cloning learners'
+        defaults["explore_subgoal_reach"] = 0.0
+    if not registry.reads(learner.name, "buffer_window"):  # as the window, which HER and ES do not read
+        defaults.update(buffer_window=0, buffer_window_grow=0)
+    for name, value in defaults.items():  # fill per-algorithm, then per-task defaults for fields left at None
+        if getattr(c, name) is None:
+            setattr(c, name, value)
+    c.hidden = tuple(int(w) for w in c.hidden)
+    check(0 <= c.seed < 2**32, "seed", c.seed, "an integer in [0, 2**32)")
+    for f in TrainConfig.settings_fields():  # inf and nan pass every range check, and JSON cannot hold them
+        if f.type == "float":
+            check(math.isfinite(getattr(c, f.name)), f.name, getattr(c, f.name), "a finite number")
+        if f.type == "bool":  # a string such as "False" would pass every truth test
+            check(isinstance(getattr(c, f.name), bool), f.name, getattr(c, f.name), "true or false")
+    in_range = 1 <= c.iterations <= MAX_ITERATIONS
+    check(in_range, "iterations", c.iterations, f"an integer in [1, {MAX_ITERATIONS}]")
+    check(c.num_envs >= 1, "num_envs", c.num_envs, "an integer >= 1")
+    check(c.num_devices >= 0, "num_devices", c.num_devices, "an integer >= 0 (0: every device)")
+    check(len(c.hidden) >= 1 and min(c.hidden) >= 1, "hidden", c.hidden, "one or more widths >= 1")
+    check(c.horizon >= 1, "horizon", c.horizon, "an integer >= 1 (and < the episode length)")
+    registry.settings(c)  # the learner's own settings, each checked against its range
+    if learner.grows_horizon and c.pchid_every == 0:  # resolved once, so a resume keeps the schedule
+        c.pchid_every = max(1, c.iterations // (2 * c.horizon))
+    check(c.eval_every >= 1, "eval_every", c.eval_every, "an integer >= 1")
+    check(
+        c.iterations % c.eval_every == 0,
+        "iterations",
+        c.iterations,
+        f"a multiple of eval_every={c.eval_every}",
+    )
+    check(c.eval_episodes >= 1, "eval_episodes", c.eval_episodes, "an integer >= 1")
+    reach = c.eval_subgoal_reach
+    check(reach >= 0, "eval_subgoal_reach", reach, "a distance >= 0 (0: no subgoals)")
+    check(c.checkpoint_every >= 0, "checkpoint_every", c.checkpoint_every, "an integer >= 0")
+    if c.run_dir is None:
+        c.run_dir = os.path.join("runs", f"{c.env}-s{c.seed}")
+    check(c.run_dir.strip() != "", "run_dir", c.run_dir, "a directory name, not empty")
+    check(is_utf8(c.run_dir), "run_dir", c.run_dir, "a path of UTF-8 text (checkpoints are written by it)")
+    check(not os.path.isfile(c.run_dir), "run_dir", c.run_dir, "a directory, not an existing file")
 
 
 def _on_baselines(text: Any) -> Any:

@@ -200,7 +200,7 @@ def build_parser() -> Parser:
     return parser
 
 
-TYPES = {f.name: str(f.type) for f in dataclasses.fields(TrainConfig)}
+TYPES = {f.name: str(f.type) for f in TrainConfig.settings_fields()}
 
 
 def _sweepable(algo: str) -> tuple[str, ...]:

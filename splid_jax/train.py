@@ -13,7 +13,6 @@ if __name__ == "__main__":  # a signal while JAX loads ends the process with one
     check_environment()
 
 import argparse  # noqa: E402
-import dataclasses  # noqa: E402
 import json  # noqa: E402
 import os  # noqa: E402
 import sys  # noqa: E402
@@ -101,7 +100,7 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
     if os.path.isfile(os.path.join(ns.resume, EXPORT)):
         why = f"a run train wrote, not an export without its buffer (its {EXPORT} names the run)"
         raise InvalidConfig("resume", ns.resume, why)
-    names = {f.name for f in dataclasses.fields(TrainConfig)}
+    names = {f.name for f in TrainConfig.settings_fields()}
     try:
         with open(path) as fh:
             saved = json.load(fh)

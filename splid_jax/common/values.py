@@ -119,12 +119,3 @@ def typed_fields(cls, values: dict[str, Any], prefix: str) -> dict[str, Any]:
         check(key in fields, where, value, "one of the fields " + ", ".join(fields))
         typed[key] = typed_value(where, str(fields[key].type), value)
     return typed
-
-
-def option_fields(cls) -> str:
-    """``field=default (help); ...`` of a learner's config dataclass, for ``--help``."""
-    shown = []
-    for f in dataclasses.fields(cls):
-        default = ",".join(map(str, f.default)) if isinstance(f.default, tuple) else f.default
-        shown.append(f"{f.name}={default} ({f.metadata.get('help', '')})")
-    return "; ".join(shown)

@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Sequence
 from typing import Any
 
@@ -37,7 +36,7 @@ def parse_methods(text: str, allowed: Sequence[str]) -> tuple[str, ...]:
 
 def parse_sets(items: Sequence[str], methods: Sequence[str]) -> dict[str | None, dict[str, Any]]:
     """``[METHOD.]FIELD=VALUE`` items as {None: fields for every method, METHOD: its own fields}."""
-    types = {f.name: f.type for f in dataclasses.fields(TrainConfig)}
+    types = {f.name: f.type for f in TrainConfig.settings_fields()}
     out: dict[str | None, dict[str, Any]] = {None: {}}
     for item in items:
         key, eq, value = item.partition("=")

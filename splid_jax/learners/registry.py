@@ -108,7 +108,7 @@ def settings(cfg) -> Any:
     learner = get(cfg.algo)
     if learner.options is not None:
         return parse_options(learner.settings, getattr(cfg, learner.options), learner.options, learner.name)
-    return learner.settings(**{name: getattr(cfg, name) for name in IMITATION_FIELDS})
+    return learner.settings(**{name: getattr(cfg, name) for name in IMITATION_FIELDS})  # resolved: flat or nested
 
 
 def ignores(name: str) -> tuple[str, ...]:

@@ -16,7 +16,6 @@ directory's files are ``run_files``', the memory check ``memory``'s, a sweep spl
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import json
 import os
 import signal
@@ -80,7 +79,7 @@ def _lane_hyper(algo: Algorithm, base: TrainConfig, lane: TrainConfig) -> Any:
     """``algo.hyper(lane)``: a member may differ from the sweep's config only in its seed, its run_dir
     and the learner's traced settings (its registry entry's ``sweeps``)."""
     traced = registry.get(base.algo).sweeps
-    for f in dataclasses.fields(TrainConfig):
+    for f in TrainConfig.settings_fields():
         if f.name not in ("seed", "run_dir", *traced) and getattr(lane, f.name) != getattr(base, f.name):
             allowed = f"{getattr(base, f.name)!r} in every member of a sweep of {algo.name} (not a traced setting)"
             raise InvalidConfig(f.name, getattr(lane, f.name), allowed)

@@ -3,7 +3,6 @@ the checks that keep one run from overwriting another."""
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import os
 import sys
@@ -42,7 +41,7 @@ def identity(cfg: TrainConfig) -> dict:
     added after runs were recorded (field metadata ``recorded_when_set``) is left out at its default (or at
     its ``unrecorded`` value, where the default is resolved per task), which is how those runs behaved, so
     they still resume."""
-    fields = dataclasses.fields(cfg)
+    fields = cfg.settings_fields()
     later = {f.name: f.metadata.get("unrecorded", f.default) for f in fields if f.metadata.get("recorded_when_set")}
     kept = {
         k: v for k, v in cfg.to_json().items() if k not in MAY_CHANGE_ON_RESUME and not (k in later and v == later[k])

@@ -25,7 +25,7 @@ def test_seed_outside_the_prng_range_names_the_field(seed):
         TrainConfig(env="point", seed=seed)
 
 
-@pytest.mark.parametrize("field", [f.name for f in dataclasses.fields(TrainConfig) if f.type == "float"])
+@pytest.mark.parametrize("field", [f.name for f in TrainConfig.settings_fields() if f.type == "float"])
 @pytest.mark.parametrize("value", [float("inf"), float("-inf"), float("nan")])
 def test_every_float_field_must_be_finite(field, value):
     with pytest.raises(InvalidConfig, match=f"invalid {field}=.*finite"):
@@ -33,7 +33,7 @@ def test_every_float_field_must_be_finite(field, value):
 
 
 def test_every_field_has_help():
-    for f in dataclasses.fields(TrainConfig):
+    for f in TrainConfig.settings_fields():
         assert f.metadata.get("help"), f.name
 
 

@@ -104,5 +104,14 @@ def test_the_paper_preset_clones_with_rmsprop():
 
 def test_the_relabellings_named_in_the_config_are_selects_strategies():
     assert RELABELS == relabel.NAMES and relabel.HOLDING == ("hold", "stop")
-    fields = {f.name for f in dataclasses.fields(TrainConfig)}
+    fields = {f.name for f in TrainConfig.settings_fields()}
     assert not fields & {"hold_horizon", "rest_horizon", "select_radius", "held_share"}  # retired
+
+
+def test_the_run_config_holds_the_runs_settings_and_each_learners_own_apart():
+    own = [f.name for f in dataclasses.fields(TrainConfig)]
+    assert len(own) <= 20 and "cloning" in own and not set(own) & {"horizon", "sigma", "learning_rate"}
+    cfg = TrainConfig(env="push", horizon=8)
+    assert cfg.cloning == cfg.learner_config() and cfg.horizon == cfg.cloning.horizon == 8
+    assert dataclasses.replace(cfg, horizon=5).cloning.horizon == 5
+    assert set(cfg.to_json()) == {f.name for f in TrainConfig.settings_fields()}  # config.json: flat, as ever

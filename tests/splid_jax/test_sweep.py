@@ -97,7 +97,7 @@ def test_a_varied_window_resolves_pushs_widening_as_a_given_one_would(tmp_path):
 def test_vary_names_the_field_of_a_bad_value(capsys, tmp_path, vary, field):
     assert sweep.main(["--env", "point", "--vary", vary, "--run-dir", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+    assert len(err.splitlines()) == 1 and f"invalid --{field.replace('.', '-').replace('_', '-')} " in err
     assert not (tmp_path / "x").exists()
 
 
@@ -107,7 +107,7 @@ def test_vary_refuses_a_field_given_twice_or_one_the_learner_does_not_trace(caps
                         (["--algo", "pchid", "--vary", "horizon_end=0,2"], "vary")]:  # fmt: skip
         assert sweep.main(["--env", "point", *args, "--run-dir", str(tmp_path / "x")]) == 2
         err = capsys.readouterr().err.strip()
-        assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+        assert len(err.splitlines()) == 1 and f"invalid --{field.replace('.', '-').replace('_', '-')} " in err
     assert not (tmp_path / "x").exists()
 
 
@@ -135,7 +135,7 @@ def test_cli_rejects_a_bad_grid(capsys, tmp_path):
 def test_cli_names_the_field_of_a_bad_value(capsys, tmp_path, args, field):
     assert sweep.main(["--env", "point", *args, "--run-dir", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+    assert len(err.splitlines()) == 1 and f"invalid --{field.replace('.', '-').replace('_', '-')} " in err
     assert not (tmp_path / "x").exists()
 
 
@@ -168,14 +168,15 @@ def test_a_second_sweep_into_one_dir_is_refused_and_a_sweep_resumes(capsys, tmp_
     assert sweep.main([*args, "--iterations", "2", "--run-dir", run_dir]) == 0
     kept = read(tmp_path / "sweep" / "sigma1-H4-s0" / "metrics.jsonl")
     assert sweep.main([*args, "--iterations", "4", "--sigmas", "0.5", "--run-dir", run_dir]) == 2
-    assert "run_dir" in capsys.readouterr().err
+    assert "--run-dir" in capsys.readouterr().err
     assert read(tmp_path / "sweep" / "sigma1-H4-s0" / "metrics.jsonl") == kept
     other_grids = [(["--seeds", "3"], "seeds"), (["--sigmas", "0.5"], "sigmas"), (["--horizons", "2"], "horizons"),
                    (["--vary", "learning_rate=0.01"], "learning_rate")]  # fmt: skip
     for grid, field in other_grids:
         assert sweep.main(["--resume", run_dir, *grid, "--iterations", "4", "--no-plot", "--quiet"]) == 2
         err = capsys.readouterr().err.strip()
-        assert len(err.splitlines()) == 1 and f"invalid {field}=" in err and "as in the sweep being resumed" in err
+        flag = f"--{field.replace('_', '-')} "
+        assert len(err.splitlines()) == 1 and f"invalid {flag}" in err and "as in the sweep being resumed" in err
     assert read(tmp_path / "sweep" / "sigma1-H4-s0" / "metrics.jsonl") == kept
     same = ["--seeds", "2", "--sigmas", "1", "--horizons", "4"]  # the grid it started with may be given again
     assert sweep.main(["--resume", run_dir, *same, "--iterations", "4", "--no-plot", "--quiet"]) == 0

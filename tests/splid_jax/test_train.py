@@ -146,7 +146,7 @@ def test_help_documents_every_flag(capsys):
         main(["--help"])
     assert exc.value.code == 0
     out = " ".join(capsys.readouterr().out.split())
-    for f in dataclasses.fields(TrainConfig):
+    for f in TrainConfig.settings_fields():
         flag = "--" + f.name.replace("_", "-")
         help_start = " ".join(f.metadata["help"].split()[:4])
         assert f"{flag} " in out and help_start in out, f.name
@@ -287,7 +287,7 @@ def test_resume_to_fewer_iterations_is_refused_and_a_finished_run_is_complete(tm
     capsys.readouterr()
     assert main(["--resume", str(run_dir), "--iterations", "5"]) == 2
     err = capsys.readouterr().err
-    assert "iterations=5" in err and ">= 10" in err
+    assert "--iterations 5" in err and ">= 10" in err
     assert main(["--resume", str(run_dir)]) == 0
     assert "already complete" in capsys.readouterr().out
     assert {p: (run_dir / p).read_bytes() for p in files} == files
@@ -298,7 +298,7 @@ def test_metrics_without_a_checkpoint_are_not_overwritten(tmp_path, capsys):
     run_dir.mkdir()
     (run_dir / "metrics.jsonl").write_text('{"iteration": 5}\n' * 30)
     assert main([*TINY, "--iterations", "5", "--run-dir", str(run_dir)]) == 2
-    assert "run_dir" in capsys.readouterr().err
+    assert "--run-dir" in capsys.readouterr().err
     assert (run_dir / "metrics.jsonl").read_text() == '{"iteration": 5}\n' * 30
 
 
@@ -434,4 +434,4 @@ def test_a_gpu_compiler_failing_on_the_solve_kernel_is_one_line(tmp_path, capsys
     monkeypatch.setattr(GoalEnv, "kernel_fallback", lambda self, e: "another solver (" + str(e).split()[1] + ")")
     assert main([*TINY, "--iterations", "5", "--run-dir", str(tmp_path / "run")]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "env_options" in err and "another solver (Triton)" in err
+    assert len(err.splitlines()) == 1 and "--env-options" in err and "another solver (Triton)" in err

@@ -132,7 +132,7 @@ def select(
     T x N explored steps (speed, never a verdict). ``relabel`` names the strategy (``relabel.STRATEGIES``)."""
     strategy, (T, H, n) = STRATEGIES[relabel], (env.episode_length, max_horizon, traj.actions.shape[1])
     hs = hindsight(env, traj, H)  # lines 12-14: for t = 1..T, h = 1..H: g' = m(s_{t+h})
-    moved, held = strategy.candidates(hs, horizon)
+    moved, held = strategy.candidates(hs, horizon)  # paper: every g' the object moved to, h <= H
     valid, held, goal = (moved | held).reshape(-1), held.reshape(-1), hs.goal.reshape(H * T * n, -1)
     reached, steps = jnp.zeros_like(valid), jnp.int32(0)
     if use_select:  # line 15: SELECT(s_t, g'): does the policy, restored at s_t, reach g' within h steps?
@@ -141,7 +141,7 @@ def select(
         start_of, h_of, lanes = flat % (T * n), flat // (T * n) + 1, num_lanes(T, n, lanes, H)
         reached, steps = replay_queue(env, policy, pstate, starts, goal, start_of, h_of, valid, lanes, held)
     tile = lambda x: jnp.broadcast_to(x[None], (H,) + x.shape).reshape((H * T * n,) + x.shape[2:])  # noqa: E731
-    action = strategy.label(tile(traj.actions), held)  # line 16: store (s_t, g', a_t) where it did not
+    action = strategy.label(tile(traj.actions), held)  # line 16: store (s_t, g', a_t) where the policy did not
     out = Candidates(tile(traj.states.obs), goal, action, valid, valid & ~reached, held, steps)
     chex.assert_shape([out.valid, out.accept, out.held], (num_candidates(T, H, n),))
     return out

@@ -81,7 +81,7 @@ def test_each_algo_writes_the_schema_and_resumes_bit_for_bit(tmp_path, algo):
     "args,field",
     [
         (["--algo", "her", "--her-options", "batch_size=0"], "her.batch_size"),
-        (["--algo", "her", "--her-options", "bogus=1"], "her.bogus"),
+        (["--algo", "her", "--her-options", "bogus=1"], "her.bogus="),  # no flag of that name
         (["--algo", "her", "--her-options", "gamma=big"], "her.gamma"),
         (["--algo", "her", "--her-options", "hidden=16,x"], "her.hidden"),
         (["--algo", "her", "--her-options", "n_batches"], "her_options"),
@@ -90,6 +90,8 @@ def test_each_algo_writes_the_schema_and_resumes_bit_for_bit(tmp_path, algo):
         (["--algo", "splid", "--her-options", "batch_size=32"], "her_options"),  # another algo's options
         (["--algo", "her", "--es-options", "population=8"], "es_options"),
         (["--algo", "es", "--num-envs", "8"], "num_envs"),  # the population sets it
+        (["--algo", "her", "--her-batch-size", "0"], "her.batch_size"),
+        (["--algo", "splid", "--her-batch-size", "32"], "her_options"),
         (["--algo", "her", "--hidden", "16"], "hidden"),  # HER's networks are her_options'
         (["--algo", "es", "--sigma", "0.5"], "sigma"),
     ],
@@ -97,7 +99,8 @@ def test_each_algo_writes_the_schema_and_resumes_bit_for_bit(tmp_path, algo):
 def test_bad_algo_options_are_one_line_naming_the_field(tmp_path, capsys, args, field):
     assert main([*args, "--run-dir", str(tmp_path / "run")]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+    typed = field if field.endswith("=") else f"--{field.replace('.', '-').replace('_', '-')} "
+    assert len(err.splitlines()) == 1 and f"invalid {typed}" in err
     assert not (tmp_path / "run").exists()
 
 
@@ -125,6 +128,7 @@ def test_help_lists_each_learners_fields_and_defaults(capsys):
     with pytest.raises(SystemExit):
         main(["--help"])
     text = " ".join(capsys.readouterr().out.split())
-    assert "batch_size=2000 (" in text and "replay_k=2 (" in text and "population=256 (" in text
+    assert "--her-batch-size BATCH_SIZE transitions per gradient step (default: 2000)" in text
+    assert "--her-replay-k REPLAY_K" in text and "--es-population POPULATION" in text
     assert "her on reach, push, slide, pick_and_place: 8" in text
     assert "her on push, pick_and_place: 2500" in text and "her on slide: 6250" in text

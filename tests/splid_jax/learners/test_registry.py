@@ -43,7 +43,7 @@ def test_every_name_builds_its_own_learner_from_its_own_settings():
 
 def test_a_learner_reads_its_settings_and_the_runs_and_ignores_the_others():
     learners_own = {*registry.IMITATION_FIELDS, "her_options", "es_options"}
-    run_fields = [f.name for f in dataclasses.fields(TrainConfig) if f.name not in learners_own]
+    run_fields = [f.name for f in TrainConfig.settings_fields() if f.name not in learners_own]
     for name in registry.names():
         assert all(registry.reads(name, f) for f in run_fields if f != "num_envs"), name
     assert registry.ignores("splid") == ("gcsl_relabel", "pchid_every")

@@ -118,7 +118,7 @@ def test_only_process_0_writes_and_each_member_computes_as_in_one_process(two_pr
 def test_a_bad_launch_is_one_line_naming_the_flag(capsys, tmp_path, main, args, field, flag):
     assert main(["--env", "point", *args, "--run-dir", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and f"invalid {field}=" in err and flag in err
+    assert len(err.splitlines()) == 1 and f"invalid {flag} " in err
     assert not (tmp_path / "x").exists()
 
 
@@ -130,7 +130,7 @@ def test_process_0_refuses_a_coordinator_port_in_use(capsys, tmp_path):
         args = ["--env", "point", "--num-processes", "2", "--process-id", "0", "--coordinator", where]
         assert sweep.main([*args, "--run-dir", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and f"invalid coordinator='{where}'" in err and "in use" in err
+    assert len(err.splitlines()) == 1 and f"invalid --coordinator {where}:" in err and "in use" in err
 
 
 def test_one_process_needs_no_launch_and_its_errors_travel_whole():
