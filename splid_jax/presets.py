@@ -35,7 +35,7 @@ from splid_jax.common.values import options_text
 from splid_jax.learners.her.config import BASELINES, BASELINES_WORKERS, HerConfig
 
 PRESETS = {
-    "tuned": "what learned best where it was compared (the default; this module's docstring)",
+    "tuned": "what learned best where it was compared; splid_jax/presets.py says what and why",
     "paper": "Algorithm 2 at the paper's settings, the authors' code where the paper is silent; HER: OpenAI Baselines",
 }
 
