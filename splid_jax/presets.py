@@ -54,7 +54,11 @@ _HELD_STEERED: dict[str, Any] = {
     "explore_subgoal_reach": 0.1,
 }  # fmt: skip
 
-# the tuned preset: every task's run settings and the cloning learners' (SPLID's) settings
+# The tuned preset: every task's run settings and the cloning learners' (SPLID's) settings. Push's window: the
+# newest 50k pairs alone learn fast and fall late as the buffer turns over, all 200k hold the peak but start slower;
+# widening from one to the other over 200 iterations keeps both. Its subgoals' 0.1 m lies near the buffer's median
+# goal distance from the cube. Slide stops where its final step peaks (100k pairs reach the same peak later);
+# PickAndPlace's 50k pairs turned over in a few iterations as SELECT's intake shrank, and its final step fell.
 TUNED: dict[str, dict[str, Any]] = {
     "point": _POINT,
     "reach": {**_FETCH, "iterations": 20, "num_envs": 64, "relative_goal": True},
