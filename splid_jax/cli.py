@@ -116,6 +116,8 @@ def flag_error(err, parser: argparse.ArgumentParser) -> str:
         return typed(str(err))
     value = ",".join(map(str, err.value)) if isinstance(err.value, tuple | list) else err.value
     value = "(unset)" if value is None else value
+    if not str(value) or not str(value).isprintable() or str(value).encode(errors="replace").decode() != str(value):
+        value = repr(value)  # empty, or a name no terminal shows as typed: quoted, with its escapes
     head = f"{flag(err.field)} {value}" if flag(err.field) else f"{err.field}={err.value!r}"
     return f"invalid {head}: must be {typed(err.allowed)}"
 
