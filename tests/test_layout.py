@@ -106,3 +106,12 @@ def test_no_module_imports_another_modules_private_name():
     modules = project_modules()
     found = {name: uses for name, tree in modules.items() if (uses := private_uses(tree, modules))}
     assert found == {}
+
+
+def test_the_tasks_import_nothing_of_the_trainer():
+    """``envs`` stands alone: a task is usable without the learners, and the trainer depends on it, not back."""
+    modules = project_modules()
+    edges = {name: {m for m, _ in imports(tree, modules)} for name, tree in modules.items() if name.startswith("envs")}
+    assert {"envs", "envs.fetch.tasks"} <= set(edges)
+    assert {name: sorted(m for m in used if m.startswith("splid_jax")) for name, used in edges.items()
+            if any(m.startswith("splid_jax") for m in used)} == {}  # fmt: skip

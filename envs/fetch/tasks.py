@@ -36,7 +36,7 @@ from flax import struct
 from envs import fused_collision, fused_solver, small_cholesky, solver_loops
 from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
 from envs.fetch import models
-from splid_jax.common.errors import check, check_integer
+from envs.settings import check, check_integer
 
 MIN_OBJECT_DISTANCE = 0.1  # the object starts at least this far from the gripper in xy
 _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4) ** 64 ~ 2e-7
