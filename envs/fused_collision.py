@@ -19,7 +19,6 @@ amplifies rounding, as it does between MJX's own variants (``tests/envs/test_fus
 
 from __future__ import annotations
 
-import contextlib
 import functools
 
 import jax
@@ -29,7 +28,7 @@ import numpy as np
 from envs import kernel_batch
 from envs.base import data_with
 from envs.fused_solver import at_mask
-from envs.small_cholesky import TRACE_LOCK
+from envs.mjx_patch import patched_mjx
 
 _FACE = np.array([0, 4, 5, 1, 0, 2, 6, 4, 6, 7, 5, 4, 2, 3, 7, 6, 1, 5, 7, 3, 0, 1, 3, 2]).reshape(6, 4)
 _NORMAL = np.array([[0, -1, 0], [0, 0, -1], [1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0]], dtype=np.float32)
@@ -440,30 +439,20 @@ def _limited(group, mjx_group, max_envs: int):
     return collide
 
 
-@contextlib.contextmanager
-def fused_in_mjx(enabled: bool = True, kernel: bool = False, max_envs: int = 0, num_warps: int | None = None):
-    """Within the block, MJX's collision driver collides planes with boxes and boxes with boxes through
-    ``plane_box`` and ``box_box`` (as Pallas kernels of ``num_warps`` warps per pair if ``kernel``, at batches up
-    to ``max_envs`` if not 0). The
-    driver looks its functions up when its code runs, which under ``jit`` is trace time only."""
-    if not enabled:
-        yield
-        return
+def groups(kernel: bool = False, max_envs: int = 0, num_warps: int | None = None) -> dict:
+    """The collision driver's functions for planes against boxes and boxes against boxes, as ``envs/mjx_patch.py``
+    puts them in its table: ``plane_box`` and ``box_box`` (as Pallas kernels of ``num_warps`` warps per pair if
+    ``kernel``, at batches up to ``max_envs`` if not 0, MJX's own above)."""
     from mujoco.mjx._src import collision_driver
     from mujoco.mjx._src.types import GeomType
 
-    groups = {(GeomType.PLANE, GeomType.BOX): _plane_box_group, (GeomType.BOX, GeomType.BOX): _box_box_group}
-    table = collision_driver._COLLISION_FUNC
-    with TRACE_LOCK:
-        saved = {key: table[key] for key in groups}
-        for key, group in groups.items():
-            fn = functools.partial(group, kernel=kernel, num_warps=num_warps)
-            table[key] = _limited(fn, saved[key], max_envs) if kernel and max_envs else fn
-            table[key].ncon = 4
-        try:
-            yield
-        finally:
-            table.update(saved)
+    own = {(GeomType.PLANE, GeomType.BOX): _plane_box_group, (GeomType.BOX, GeomType.BOX): _box_box_group}
+    table = {}
+    for key, group in own.items():
+        fn = functools.partial(group, kernel=kernel, num_warps=num_warps)
+        table[key] = _limited(fn, collision_driver._COLLISION_FUNC[key], max_envs) if kernel and max_envs else fn
+        table[key].ncon = 4
+    return table
 
 
 def contacts(task, physics, fused: bool):
@@ -472,6 +461,6 @@ def contacts(task, physics, fused: bool):
     from mujoco import mjx
 
     data = data_with(mjx.make_data(task.mjx_model), physics)
-    with fused_in_mjx(fused):
+    with patched_mjx(collide=groups() if fused else None):
         c = mjx.forward(task.mjx_model, data)._impl.contact
     return c.dist, c.pos, c.frame

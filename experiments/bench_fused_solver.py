@@ -36,8 +36,8 @@ with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on i
 import envs  # noqa: E402
 from envs import fused_solver, small_cholesky  # noqa: E402
 from envs.base import data_with  # noqa: E402
+from envs.fetch.kernels import KERNELS, mjx_with_kernels  # noqa: E402
 from envs.fetch.scripted import CONTROLLERS  # noqa: E402
-from envs.fetch.tasks import KERNELS  # noqa: E402
 
 
 def presolve_states(env, batch: int, steps: int, seed: int):
@@ -102,7 +102,7 @@ def main() -> None:
     gpu = jax.default_backend() == "gpu"
 
     def mjx_solve(d):
-        with env.solver_in_mjx():
+        with mjx_with_kernels(env):
             return mjx_solver.solve(model, d)
 
     variants = {f"mjx ({env.solver_loops})": mjx_solve}

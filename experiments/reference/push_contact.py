@@ -16,7 +16,7 @@ import mujoco
 import numpy as np
 
 from envs.fetch import models
-from envs.fetch.tasks import quat_to_euler
+from envs.fetch.rotations import quat_to_euler
 from splid_jax.reference.extra import make_reference
 from splid_jax.reference.mapping import reference_start
 

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import envs
-from envs.fetch import models, scripted, tasks
+from envs.fetch import models, rotations, scripted, tasks
 from splid_jax.common.errors import InvalidConfig
 
 NAMES = ["reach", "push", "slide", "pick_and_place"]
@@ -202,7 +202,7 @@ def test_euler_angles_match_the_rotation():
         return jnp.concatenate([(w1 * w2 - v1 @ v2)[None], w1 * v2 + w2 * v1 + jnp.cross(v1, v2)])
 
     q = mul(mul(half([1.0, 0, 0], a), half([0, 1.0, 0], b)), half([0, 0, 1.0], c))  # R = Rx Ry Rz
-    np.testing.assert_allclose(tasks.quat_to_euler(q), [a, b, c], atol=1e-5)
+    np.testing.assert_allclose(rotations.quat_to_euler(q), [a, b, c], atol=1e-5)
 
 
 def _pairs(m: mujoco.MjModel) -> set[tuple[str, str]]:

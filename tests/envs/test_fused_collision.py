@@ -14,8 +14,8 @@ from mujoco.mjx._src.collision_types import GeomInfo
 
 import envs
 from envs import fused_collision
+from envs.fetch.kernels import runs_as_kernel
 from envs.fetch.scripted import CONTROLLERS
-from envs.fetch.tasks import runs_as_kernel
 from tests.helpers import triton_calls_in_step
 
 
@@ -125,12 +125,10 @@ def test_push_path_follows_mjxs():
     np.testing.assert_allclose(fused, base, atol=1e-5)
 
 
-def test_driver_keeps_mjxs_function_outside_the_block():
-    before = dict(collision_driver._COLLISION_FUNC)
-    with fused_collision.fused_in_mjx():
-        swapped = {k for k, f in collision_driver._COLLISION_FUNC.items() if f is not before[k]}
-        assert swapped == {(0, 6), (6, 6)}  # plane-box and box-box
-    assert collision_driver._COLLISION_FUNC == before
+def test_the_driver_is_given_the_plane_box_and_box_box_groups_alone():
+    groups = fused_collision.groups()
+    assert set(groups) == {(0, 6), (6, 6)} and {g.ncon for g in groups.values()} == {4}  # four contacts a pair
+    assert set(groups) <= set(collision_driver._COLLISION_FUNC)
     assert [runs_as_kernel("gpu-fused", b) for b in ("gpu", "cpu")] == [True, False]
 
 
