@@ -27,9 +27,14 @@ def installed() -> tuple[str, str]:
     return mujoco.__version__, mjx
 
 
+def kernels_checked() -> bool:
+    """Whether the installed MuJoCo is the release the kernels were checked against."""
+    return all(v == KERNELS_CHECKED for v in installed())
+
+
 def in_use(choice: str) -> str:
     """The backend a task set to ``choice`` runs: ``kernels`` only on the checked MuJoCo version."""
-    if choice != "kernels" or all(v == KERNELS_CHECKED for v in installed()):
+    if choice != "kernels" or kernels_checked():
         return choice
     _notice(installed(), KERNELS_CHECKED)
     return "mjx"

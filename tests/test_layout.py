@@ -115,3 +115,11 @@ def test_the_tasks_import_nothing_of_the_trainer():
     assert {"envs", "envs.fetch.tasks"} <= set(edges)
     assert {name: sorted(m for m in used if m.startswith("splid_jax")) for name, used in edges.items()
             if any(m.startswith("splid_jax") for m in used)} == {}  # fmt: skip
+
+
+def test_no_task_module_over_400_lines():
+    """One module, one job: a task module that grows past 400 lines holds two."""
+    lines = {str(p.relative_to(REPO)): len(p.read_text().splitlines()) for p in (REPO / "envs").rglob("*.py")}
+    assert len(lines) > 10
+    long = {path: n for path, n in lines.items() if n > 400}
+    assert long == {}

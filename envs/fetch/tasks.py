@@ -8,7 +8,7 @@ the gripper target by ``0.05 * a[:3]`` per 0.04 s control step.
 Gripper target: as in the reference, the *current* grip position plus ``0.05 * a[:3]``, clipped to
 a workspace box whose floor keeps the fingertips at or above the table (with ``finger_table`` the
 floor lies 2.5 cm lower and the fingers' contact with the table holds them), then within the reference
-arm's reach (``models.within_reach``; ``workspace="box"`` drops it). The target is the actuator
+arm's reach (``control.within_reach``; ``workspace="box"`` drops it). The target is the actuator
 control, which ``Physics`` holds (with ``drive="weld"``, ``simulate`` puts a mocap body there).
 
 ``State.physics`` (a ``Physics``) is the complete simulator state: qpos, qvel, ctrl, time and the
@@ -37,7 +37,7 @@ import jax
 import jax.numpy as jnp
 
 from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
-from envs.fetch import kernels, models, observation
+from envs.fetch import control, kernels, models, observation
 from envs.fetch.observation import Physics
 from envs.physics import BACKENDS, in_use
 from envs.settings import check, check_integer
@@ -132,7 +132,7 @@ class _FetchTask(GoalEnv):
         check(self.table in tables, f"{n}.table", self.table, "one of " + ", ".join(tables))
         fingers = models.fingers_for(n)
         check(self.finger in fingers, f"{n}.finger", self.finger, "one of " + ", ".join(fingers))
-        spaces = models.WORKSPACES
+        spaces = control.WORKSPACES
         check(self.workspace in spaces, f"{n}.workspace", self.workspace, "one of " + ", ".join(spaces))
         check(self.drive in models.DRIVES, f"{n}.drive", self.drive, "one of " + ", ".join(models.DRIVES))
         check(self.physics in BACKENDS, f"{n}.physics", self.physics, "one of " + ", ".join(BACKENDS))
@@ -260,7 +260,7 @@ class _FetchTask(GoalEnv):
         g = lay.grip_q
         reach = lay.reach_center if self.workspace == "arm" else None
         lo = (*lay.workspace_lo[:2], lay.workspace_lo[2] + self.floor_clearance)
-        target = models.gripper_target(phys.qpos[g : g + 3], action[:3], lay.grip_home, lo,
+        target = control.gripper_target(phys.qpos[g : g + 3], action[:3], lay.grip_home, lo,
                                        lay.workspace_hi, reach, xp=jnp)  # fmt: skip
         ctrl = phys.ctrl.at[0:3].set(target)
         if lay.finger_q is not None:

@@ -13,7 +13,7 @@ from mujoco.mjx._src import collision_convex, collision_driver, math, mesh
 from mujoco.mjx._src.collision_types import GeomInfo
 
 import envs
-from envs import fused_collision
+from envs import box_contacts, fused_collision
 from envs.fetch.kernels import runs_as_kernel
 from envs.fetch.scripted import CONTROLLERS
 from tests.helpers import triton_calls_in_step
@@ -62,7 +62,7 @@ def _contacts(dist, pos, i):
 def test_box_box_makes_mjxs_contacts():
     args = _pairs(90)
     want = jax.jit(_mjx)(*args)
-    got = jax.jit(jax.vmap(fused_collision.box_box))(*args)
+    got = jax.jit(jax.vmap(box_contacts.box_box))(*args)
     np.testing.assert_allclose(got[2], want[2], atol=1e-5)  # the normal's frame: the same separating axis
     touching = np.asarray(want[0] < 0).any(axis=1)
     assert touching.sum() > 50
@@ -74,8 +74,8 @@ def test_kernels_are_the_functions_and_lower_as_one_triton_call_each():
     args = _pairs(12, seed=1)
     plane = (args[3], args[4], *args[:3])  # the second box's frame as a plane, the first box on it
     cases = [
-        (fused_collision.box_box, fused_collision.kernel_box_box, args),
-        (fused_collision.plane_box, fused_collision.kernel_plane_box, plane),
+        (box_contacts.box_box, fused_collision.kernel_box_box, args),
+        (box_contacts.plane_box, fused_collision.kernel_plane_box, plane),
     ]
     for function, kernel_fn, inputs in cases:
         plain = jax.jit(jax.vmap(function))(*inputs)
