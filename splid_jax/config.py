@@ -21,9 +21,9 @@ from splid_jax.common.values import format_overrides, options_text, parse_option
 from splid_jax.learners import registry
 
 MAX_ITERATIONS = 10**7  # far beyond any run's budget: a larger value is a typo, and would run for ever
-# Keys a run's config.json holds beside the fields: where it ran, and which defaults its learner's options
-# are read against (HER's defaults were Baselines' before they became mrl's).
-PROVENANCE = ("devices", "her_defaults")
+# Keys a run's config.json holds beside the fields: where it ran, the physics code it ran, and which defaults its
+# learner's options are read against (HER's defaults were Baselines' before they became mrl's).
+PROVENANCE = ("devices", "her_defaults", "physics")
 HER_DEFAULTS = "mrl"
 
 

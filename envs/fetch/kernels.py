@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import jax
 
-from envs import fused_collision, fused_solver, mjx_patch, small_cholesky, solver_loops
 from envs.settings import check, check_integer
 
 CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
@@ -45,7 +44,10 @@ def check_options(task) -> None:
 def mjx_with_kernels(task):
     """The block within which MJX steps as ``task``'s ``cholesky``, ``solver_loops`` and ``collision`` choose
     (the kernels up to ``kernel_envs`` envs, with ``kernel_warps`` warps per env), on the backend being traced
-    for: the step's only way to the replaced functions."""
+    for: the step's only way to the replaced functions. The modules that reach into MJX's private code are imported
+    here, so a task on a MuJoCo whose private code moved still imports and runs stock MJX."""
+    from envs import fused_collision, fused_solver, mjx_patch, small_cholesky, solver_loops
+
     backend = jax.default_backend()
     newton, line_search = solver_loops.writes_out(task.solver_loops, backend)
     opts = dict(kernel=backend == "gpu", max_envs=task.kernel_envs, num_warps=task.kernel_warps)

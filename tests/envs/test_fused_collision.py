@@ -16,7 +16,7 @@ import envs
 from envs import box_contacts, fused_collision
 from envs.fetch.kernels import runs_as_kernel
 from envs.fetch.scripted import CONTROLLERS
-from tests.helpers import triton_calls_in_step
+from tests.helpers import needs_kernels, triton_calls_in_step
 
 
 def _rotation(q):
@@ -132,6 +132,7 @@ def test_the_driver_is_given_the_plane_box_and_box_box_groups_alone():
     assert [runs_as_kernel("gpu-fused", b) for b in ("gpu", "cpu")] == [True, False]
 
 
+@needs_kernels
 def test_push_collides_boxes_in_kernels_on_a_gpu_by_default(monkeypatch):
     env = envs.make("push", substeps=1)
     assert triton_calls_in_step(env, monkeypatch) == (0, 3)  # plane-box and box-box contacts, the constraint solve

@@ -12,7 +12,7 @@ import numpy as np
 import envs
 from envs import fused_solver
 from envs.fetch.kernels import runs_as_kernel
-from tests.helpers import triton_calls_in_step
+from tests.helpers import needs_kernels, triton_calls_in_step
 
 
 @functools.cache
@@ -108,6 +108,7 @@ def test_solve_has_no_while_loop():
     assert "scan" in names and "while" not in names
 
 
+@needs_kernels
 def test_push_default_solves_through_the_kernel_on_a_gpu_only(monkeypatch):
     env = envs.make("push", substeps=1, collision="mjx")
     assert triton_calls_in_step(env, monkeypatch) == (0, 1)

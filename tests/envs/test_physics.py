@@ -9,6 +9,7 @@ import pytest
 import envs
 from envs import mjx_patch, physics
 from envs.settings import InvalidConfig
+from tests.helpers import needs_kernels
 
 
 def _step_jaxpr(env) -> str:
@@ -22,6 +23,7 @@ def stock():
     return _step_jaxpr(envs.make("reach", substeps=1, physics="mjx"))
 
 
+@needs_kernels
 def test_the_kernels_run_on_the_checked_version(stock):
     env = envs.make("reach", substeps=1)
     assert physics.installed() == (physics.KERNELS_CHECKED, physics.KERNELS_CHECKED)
@@ -42,7 +44,8 @@ def test_another_mujoco_runs_stock_mjx_with_a_one_line_notice(monkeypatch, capsy
     assert _step_jaxpr(env) == stock
     assert _step_jaxpr(env) == stock
     notice = capsys.readouterr().err.strip().splitlines()
-    assert len(notice) == 1 and "physics=mjx" in notice[0] and "3.17.0" in notice[0] and "0.0.0" in notice[0]
+    assert len(notice) == 1 and "physics=mjx" in notice[0] and physics.installed()[0] in notice[0]
+    assert "0.0.0" in notice[0]
 
 
 def test_the_choice_is_checked_and_recorded_when_not_the_default():

@@ -11,6 +11,7 @@ import pytest
 
 import envs
 from envs import small_cholesky
+from tests.helpers import needs_kernels
 
 
 def _spd(n, seed):
@@ -41,6 +42,7 @@ def test_large_or_batched_matrices_go_to_the_library():
     np.testing.assert_array_equal(small_cholesky.cho_factor(batch)[0], jsl.cho_factor(batch)[0])
 
 
+@needs_kernels
 @pytest.mark.slow
 def test_push_step_has_no_library_cholesky_and_steps_alike(fetch, primitives):
     fast, library = envs.make("push"), envs.make("push", cholesky="library")

@@ -12,6 +12,7 @@ import pytest
 
 import envs
 from envs import solver_loops
+from tests.helpers import needs_kernels
 
 
 @functools.cache
@@ -57,6 +58,7 @@ def _loop_primitives(choice: str | None = None) -> set[str]:
     return {p for p, n in counts.items() if n > 0}
 
 
+@needs_kernels
 def test_written_out_solver_leaves_no_loop_in_the_step():
     assert _loop_primitives("loops") == {"while[", "scan["}  # Newton, its line search, the substeps
     assert _loop_primitives("unrolled") == {"scan["}  # the substeps' loop alone
@@ -64,6 +66,7 @@ def test_written_out_solver_leaves_no_loop_in_the_step():
     assert _loop_primitives() == {"while[", "scan["}  # the default, gpu-search: the loops on the CPU
 
 
+@needs_kernels
 def test_written_out_line_search_keeps_the_newton_loop_alone():
     counts = _loop_counts(str(_program("search")[0].jaxpr), episode_scans=1)
     assert counts == {"while[": 1, "scan[": 1}  # the Newton loop and the substeps'
