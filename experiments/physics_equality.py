@@ -12,9 +12,6 @@ episodes whose success (at any step) agrees. Writes JSON to ``--out`` and a mark
 
     python experiments/physics_equality.py --out experiments/results/physics_equality.json          # on a GPU
     python experiments/physics_equality.py --out /tmp/eq.json --tasks push --batches 2 --steps 4    # CPU smoke test
-
-Supersedes ``experiments/solver_paths.py``'s and ``experiments/contact_parity.py``'s question of whether the kernels
-keep MJX's path (they compare option against option, this the backends a task offers).
 """
 
 from __future__ import annotations
