@@ -8,8 +8,7 @@ import importlib
 import io
 
 from envs.base import GoalEnv, State
-from splid_jax.common.errors import InvalidConfig
-from splid_jax.common.values import typed_value
+from envs.settings import InvalidConfig, typed_value
 
 # name -> "module:class"; imported lazily so the point task never pays for MuJoCo.
 _REGISTRY = {

@@ -43,6 +43,11 @@ class GoalEnv(abc.ABC):
         no such kernel or the error is another."""
         return None
 
+    def physics_in_use(self) -> str | None:
+        """The code that steps this task's simulator (``envs/physics.py``), as a run records it in config.json;
+        None where the task offers no choice."""
+        return None
+
     def settings(self) -> dict:
         """Every option of this task, defaults included, by name: what a checkpoint records so that a
         resume under changed task defaults is caught, not silently continued. An option that changes

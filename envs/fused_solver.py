@@ -18,8 +18,6 @@ still be running.
 
 from __future__ import annotations
 
-import contextlib
-
 import jax
 import jax.numpy as jnp
 from mujoco.mjx._src import solver as mjx_solver
@@ -27,7 +25,6 @@ from mujoco.mjx._src import support
 from mujoco.mjx._src.types import ConeType, DisableBit, SolverType
 
 from envs import kernel_batch
-from envs.small_cholesky import TRACE_LOCK
 
 MINVAL = 1e-15  # mujoco.mjMINVAL
 
@@ -284,21 +281,11 @@ def solve(m, d, kernel: bool, num_warps: int | None = None, max_envs: int = 0):
 _MJX_SOLVE = mjx_solver.solve
 
 
-@contextlib.contextmanager
-def fused_in_mjx(enabled: bool = True, kernel: bool = False, max_envs: int = 0, num_warps: int | None = None):
-    """Within the block, MJX's forward dynamics solve through ``solve`` (as a Pallas kernel of ``num_warps`` warps
-    per env if ``kernel``, at batches up to ``max_envs`` if not 0). MJX looks ``solver.solve`` up when its code
-    runs, which under ``jit`` is trace time only."""
-    if not enabled:
-        yield
-        return
+def fused(kernel: bool = False, max_envs: int = 0, num_warps: int | None = None):
+    """MJX's solve as ``envs/mjx_patch.py`` puts it in place of ``mujoco.mjx._src.solver.solve``: ``solve``, as a
+    Pallas kernel of ``num_warps`` warps per env if ``kernel``, at batches up to ``max_envs`` if not 0."""
 
     def fused_solve(m, d):  # MJX's named scope takes this name: profiles file the kernel under it
         return solve(m, d, kernel, num_warps=num_warps, max_envs=max_envs)
 
-    with TRACE_LOCK:
-        mjx_solver.solve = fused_solve
-        try:
-            yield
-        finally:
-            mjx_solver.solve = _MJX_SOLVE
+    return fused_solve

@@ -10,7 +10,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from envs.base import GoalEnv, State, flag_invalid
-from splid_jax.common.errors import check
+from envs.settings import check
 
 BOUND = 5.0
 

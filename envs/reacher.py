@@ -17,7 +17,7 @@ import jax.numpy as jnp
 from flax import struct
 
 from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
-from splid_jax.common.errors import check, check_integer
+from envs.settings import check, check_integer
 
 LINKS = (0.1, 0.11)  # shoulder to elbow, elbow to fingertip (Gym's fingertip body sits at 0.11)
 FINGERTIP_Z = 0.01

@@ -33,7 +33,7 @@ import jax.numpy as jnp
 from flax import struct
 
 from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
-from splid_jax.common.errors import check, check_integer
+from envs.settings import check, check_integer
 
 GOAL_MAX = 0.83  # the largest goal angle (GCSL's multiworld settings), rad
 HINGE_MAX = 1.0  # the hinge's upper limit, rad

@@ -9,16 +9,12 @@ and Push's step with them (``experiments/NOTES.md``, "Unrolled small Cholesky so
 It is the same algorithm (the Cholesky-Banachiewicz order), so results agree with the library's to
 float rounding.
 
-``unrolled_in_mjx()`` swaps the two functions in for the duration of a trace: MJX looks them up on
-``jax.scipy.linalg`` when its code runs, which under ``jit`` is trace time only, so the compiled
-program keeps the substitute and nothing changes outside the block. Matrices larger than
-``MAX_UNROLLED`` (the op count grows as n^3) and batched inputs go to the library functions.
+``UNROLLED`` is what ``envs/mjx_patch.py`` puts in place of ``jax.scipy.linalg``'s two functions for a
+task's step. Matrices larger than ``MAX_UNROLLED`` (the op count grows as n^3) and batched inputs go to the
+library functions.
 """
 
 from __future__ import annotations
-
-import contextlib
-import threading
 
 import jax
 import jax.numpy as jnp
@@ -28,7 +24,6 @@ MAX_UNROLLED = 16
 MIN_PIVOT = 1e-15  # mjMINVAL: MuJoCo's floor for a Cholesky pivot
 
 _LIBRARY = (jsl.cho_factor, jsl.cho_solve)
-TRACE_LOCK = threading.RLock()  # held while MJX's functions are swapped for a trace (also solver_loops, fused_*)
 
 
 def lower_factor(a: jax.Array) -> jax.Array:
@@ -92,19 +87,4 @@ def cho_solve(c_and_lower, b, overwrite_b: bool = False, check_finite: bool = Tr
     return lower_solve(c if lower else c.T, b)
 
 
-@contextlib.contextmanager
-def unrolled_in_mjx(enabled: bool = True):
-    """Within the block, ``jax.scipy.linalg.cho_factor`` / ``cho_solve`` are the unrolled ones above.
-
-    Meant around the trace of MJX calls (``mjx.step`` inside a jitted function). The (re-entrant)
-    lock keeps two threads from tracing through it at once."""
-    if not enabled:
-        yield
-        return
-    with TRACE_LOCK:
-        saved = (jsl.cho_factor, jsl.cho_solve)
-        jsl.cho_factor, jsl.cho_solve = cho_factor, cho_solve
-        try:
-            yield
-        finally:
-            jsl.cho_factor, jsl.cho_solve = saved
+UNROLLED = (cho_factor, cho_solve)

@@ -9,22 +9,19 @@ still be running (``jnp.where`` on the loop's own condition), so once converged 
 loop left it: the same arithmetic as the loops, equal to float rounding. The price is compile time:
 the solver's body is traced ``iterations * (1 + ls_iterations)`` times.
 
-``unrolled_in_mjx()`` swaps the loops in for the duration of a trace, as ``small_cholesky`` does:
-``jax.lax.while_loop`` is replaced only for loops whose body is MJX's solver's (its module), and the
-solver's scan-based line-search loop by its written-out form.
+``envs/mjx_patch.py`` puts them in for a task's step: ``solver_while`` in place of ``jax.lax.while_loop``,
+written out only for loops whose body is MJX's solver's (its module), and ``written_out_scan`` in place of
+the solver's scan-based line-search loop.
 """
 
 from __future__ import annotations
-
-import contextlib
 
 import jax
 import jax.numpy as jnp
 from mujoco.mjx._src import solver as mjx_solver
 
-from envs.small_cholesky import TRACE_LOCK
-
 _SOLVER_MODULE = mjx_solver.__name__
+_WHILE_LOOP = jax.lax.while_loop  # JAX's own, for every loop not the solver's
 
 
 def _written_out(cond, body, val, trips: int):
@@ -49,27 +46,19 @@ def writes_out(choice: str, backend: str) -> tuple[bool, bool]:
     return newton, newton or choice == "search" or (choice in ("gpu-search", "gpu-fused") and gpu)
 
 
-@contextlib.contextmanager
-def unrolled_in_mjx(iterations: int, newton: bool = True, line_search: bool = True):
-    """Within the block, MJX's Newton loop runs ``iterations`` written-out trips (``newton``) and its
-    line search ``ls_iterations`` (``line_search``; MJX passes that count); other loops are left as
-    they are."""
-    if not (newton or line_search):
-        yield
-        return
-    with TRACE_LOCK:
-        while_loop, search_loop = jax.lax.while_loop, mjx_solver._while_loop_scan
+def solver_while(iterations: int):
+    """``jax.lax.while_loop`` with the loops of MJX's solver module (its Newton loop) written out as ``iterations``
+    trips; other loops are left as they are."""
 
-        def solver_while(cond, body, init):
-            if getattr(body, "__module__", None) != _SOLVER_MODULE:
-                return while_loop(cond, body, init)
-            return _written_out(cond, body, init, iterations)
+    def while_loop(cond, body, init):
+        if getattr(body, "__module__", None) != _SOLVER_MODULE:
+            return _WHILE_LOOP(cond, body, init)
+        return _written_out(cond, body, init, iterations)
 
-        if newton:
-            jax.lax.while_loop = solver_while
-        if line_search:
-            mjx_solver._while_loop_scan = lambda cond, body, init, max_iter: _written_out(cond, body, init, max_iter)
-        try:
-            yield
-        finally:
-            jax.lax.while_loop, mjx_solver._while_loop_scan = while_loop, search_loop
+    return while_loop
+
+
+def written_out_scan(cond, body, init, max_iter: int):
+    """MJX's solver's ``_while_loop_scan`` (its line search) written out as ``max_iter`` trips (MJX passes
+    ``ls_iterations``)."""
+    return _written_out(cond, body, init, max_iter)

@@ -34,10 +34,11 @@ with contextlib.redirect_stdout(io.StringIO()):  # MJX prints a warp notice on i
     from mujoco.mjx._src import solver as mjx_solver
 
 import envs  # noqa: E402
-from envs import fused_solver, small_cholesky  # noqa: E402
+from envs import fused_solver  # noqa: E402
 from envs.base import data_with  # noqa: E402
+from envs.fetch.kernels import KERNELS, mjx_with_kernels  # noqa: E402
 from envs.fetch.scripted import CONTROLLERS  # noqa: E402
-from envs.fetch.tasks import KERNELS  # noqa: E402
+from envs.mjx_patch import patched_mjx  # noqa: E402
 
 
 def presolve_states(env, batch: int, steps: int, seed: int):
@@ -50,12 +51,8 @@ def presolve_states(env, batch: int, steps: int, seed: int):
 
     def before_solve(p):
         data = data_with(mjx.make_data(model), p)
-        with small_cholesky.TRACE_LOCK:  # MJX's forward dynamics with its solve left out
-            saved, mjx_solver.solve = mjx_solver.solve, lambda m, d: d
-            try:
-                return mjx_forward.forward(model, data)
-            finally:
-                mjx_solver.solve = saved
+        with patched_mjx(solve=lambda m, d: d):  # MJX's forward dynamics with its solve left out
+            return mjx_forward.forward(model, data)
 
     return jax.jit(jax.vmap(before_solve))(phys)
 
@@ -102,7 +99,7 @@ def main() -> None:
     gpu = jax.default_backend() == "gpu"
 
     def mjx_solve(d):
-        with env.solver_in_mjx():
+        with mjx_with_kernels(env):
             return mjx_solver.solve(model, d)
 
     variants = {f"mjx ({env.solver_loops})": mjx_solve}

@@ -26,9 +26,9 @@ from splid_jax.learners.imitation.config import ImitationConfig
 
 CLONING = frozenset(f.name for f in dataclasses.fields(ImitationConfig))
 MAX_ITERATIONS = 10**7  # far beyond any run's budget: a larger value is a typo, and would run for ever
-# Keys a run's config.json holds beside the fields: where it ran, and which defaults its learner's options
-# are read against (HER's defaults were Baselines' before they became mrl's).
-PROVENANCE = ("devices", "her_defaults")
+# Keys a run's config.json holds beside the fields: where it ran, the physics code it ran, and which defaults its
+# learner's options are read against (HER's defaults were Baselines' before they became mrl's).
+PROVENANCE = ("devices", "her_defaults", "physics")
 HER_DEFAULTS = "mrl"
 # Settings runs were once recorded with that left the package (experiments/NOTES.md, "Retired options"): a
 # config.json holding one at its neutral value loads without it, one at another value is refused

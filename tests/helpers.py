@@ -5,10 +5,17 @@ from __future__ import annotations
 
 import jax
 import jax.numpy as jnp
+import pytest
 
+from envs import physics
 from envs.base import GoalEnv, State
 from splid_jax.common.networks import Policy, PolicyState
 from splid_jax.learners.imitation.explore import Trajectory, draws, rollout
+
+# for a test of the kernels inside a task's step: on a MuJoCo they were not checked on, the tasks run stock MJX
+needs_kernels = pytest.mark.skipif(
+    not physics.kernels_checked(), reason=f"the physics kernels run on MuJoCo {physics.KERNELS_CHECKED} alone"
+)
 
 
 def explore(

@@ -106,3 +106,46 @@ def test_no_module_imports_another_modules_private_name():
     modules = project_modules()
     found = {name: uses for name, tree in modules.items() if (uses := private_uses(tree, modules))}
     assert found == {}
+
+
+def test_the_tasks_import_nothing_of_the_trainer():
+    """``envs`` stands alone: a task is usable without the learners, and the trainer depends on it, not back."""
+    modules = project_modules()
+    edges = {name: {m for m, _ in imports(tree, modules)} for name, tree in modules.items() if name.startswith("envs")}
+    assert {"envs", "envs.fetch.tasks"} <= set(edges)
+    assert {name: sorted(m for m in used if m.startswith("splid_jax")) for name, used in edges.items()
+            if any(m.startswith("splid_jax") for m in used)} == {}  # fmt: skip
+
+
+def test_no_task_module_over_400_lines():
+    """One module, one job: a task module that grows past 400 lines holds two."""
+    lines = {str(p.relative_to(REPO)): len(p.read_text().splitlines()) for p in (REPO / "envs").rglob("*.py")}
+    assert len(lines) > 10
+    long = {path: n for path, n in lines.items() if n > 400}
+    assert long == {}
+
+
+def top_level_imports(tree: ast.Module) -> set[str]:
+    """Modules ``tree`` imports when it is imported (not inside its functions)."""
+    found = set()
+    for node in tree.body:
+        if isinstance(node, ast.Import):
+            found |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            found |= {node.module} | {f"{node.module}.{a.name}" for a in node.names}
+    return found
+
+
+def test_importing_the_tasks_reaches_no_private_mjx_code():
+    """The tasks import on a MuJoCo whose private code moved, and there run stock MJX: only the physics kernels
+    (imported when a step uses them) reach into ``mujoco.mjx._src``."""
+    modules = project_modules()
+    seen, todo = set(), ["envs", "envs.fetch.tasks", "envs.fetch.scripted", "envs.reacher", "envs.sawyer_door"]
+    while todo:
+        if (name := todo.pop()) in seen or name not in modules:
+            continue
+        seen.add(name)
+        todo += [m for m in top_level_imports(modules[name]) if m in modules]
+    assert {"envs.fetch.tasks", "envs.fetch.kernels", "envs.base"} <= seen
+    private = {name for name in seen if any(m.startswith("mujoco.mjx._src") for m in top_level_imports(modules[name]))}
+    assert private == set()

@@ -8,7 +8,7 @@ the gripper target by ``0.05 * a[:3]`` per 0.04 s control step.
 Gripper target: as in the reference, the *current* grip position plus ``0.05 * a[:3]``, clipped to
 a workspace box whose floor keeps the fingertips at or above the table (with ``finger_table`` the
 floor lies 2.5 cm lower and the fingers' contact with the table holds them), then within the reference
-arm's reach (``models.within_reach``; ``workspace="box"`` drops it). The target is the actuator
+arm's reach (``control.within_reach``; ``workspace="box"`` drops it). The target is the actuator
 control, which ``Physics`` holds (with ``drive="weld"``, ``simulate`` puts a mocap body there).
 
 ``State.physics`` (a ``Physics``) is the complete simulator state: qpos, qvel, ctrl, time and the
@@ -19,78 +19,33 @@ Defaults: 10 substeps of 4 ms (the reference takes 20 of 2 ms) and Newton with 4
 line-search iterations (Slide: 10, since with 4 a resting low-friction puck crept in float32 MJX).
 That halves the physics cost and keeps the scripted controllers' success; coarser steps or fewer
 iterations change what SPLID learns (``experiments/NOTES.md``). All are task fields (``timestep``,
-``substeps``, ``iterations``, ``ls_iterations``). MJX's small dense Cholesky solves run unrolled
-(``envs/small_cholesky.py``; ``cholesky="library"`` keeps ``jax.scipy.linalg``'s, equal to float
-rounding and slower on a GPU).
+``substeps``, ``iterations``, ``ls_iterations``).
+
+The task's ``physics`` picks the code that steps MJX: ``kernels`` (the default) with parts of the
+step replaced by faster equivalents equal to float rounding (``envs/fetch/kernels.py``: MJX's small
+dense Cholesky solves unrolled, and on a GPU the solve and box contacts as Pallas kernels), or
+``mjx``, MJX as it is. A MuJoCo release the kernels were not checked on runs ``mjx``
+(``envs/physics.py``).
 """
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
+import functools
 
 import jax
 import jax.numpy as jnp
-from flax import struct
 
-from envs import fused_collision, fused_solver, small_cholesky, solver_loops
 from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
-from envs.fetch import models
-from splid_jax.common.errors import check, check_integer
+from envs.fetch import control, kernels, models, observation
+from envs.fetch.observation import Physics
+from envs.physics import BACKENDS, in_use
+from envs.settings import check, check_integer
 
 MIN_OBJECT_DISTANCE = 0.1  # the object starts at least this far from the gripper in xy
 _OBJECT_TRIES = 64  # vectorised rejection sampling: P(all rejected) <= (pi / 4) ** 64 ~ 2e-7
 GOAL_LIFT_MAX = 0.45
 GRASP_ABOVE_SITE = 0.01  # a grasped cube's centre above the grip site: inside the fingers' 6 cm height
-CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
-# MJX's solver loops, both written out, the line search alone written out, each of the last two on a GPU only, and
-# the whole solve as one program per env (envs/fused_solver.py), always or on a GPU only
-SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused", "gpu-fused")
-COLLISION = ("mjx", "fused", "gpu-fused")  # plane-box and box-box contacts: MJX's, or envs/fused_collision.py's
-KERNEL_WARPS = (1, 2, 4, 8)  # a Triton program's warps are a power of two
-KERNELS = ("fused", "gpu-fused")  # the choices above that run a part of the physics as a Pallas kernel
-
-
-def runs_as_kernel(choice: str, backend: str) -> bool:
-    """Whether a ``solver_loops`` or ``collision`` choice runs its part as envs/fused_*.py's function on
-    ``backend``: ``fused`` always, ``gpu-fused`` on a GPU only (on a CPU the functions run as XLA code: the solve
-    slower than MJX's, and MJX's keeps CPU runs as they were)."""
-    return choice == "fused" or (choice == "gpu-fused" and backend == "gpu")
-
-
-@struct.dataclass
-class Physics:
-    """Everything the future depends on; ``step`` rebuilds the simulator from this alone."""
-
-    qpos: jax.Array
-    qvel: jax.Array
-    ctrl: jax.Array
-    time: jax.Array
-    qacc_warmstart: jax.Array
-
-
-def quat_to_euler(q: jax.Array) -> jax.Array:
-    """Euler angles (a, b, c) with R = Rx(a) Ry(b) Rz(c), from a (w, x, y, z) quaternion."""
-    w, x, y, z = q[0], q[1], q[2], q[3]
-    r00 = 1 - 2 * (y * y + z * z)
-    r01 = 2 * (x * y - w * z)
-    r02 = 2 * (x * z + w * y)
-    r10 = 2 * (x * y + w * z)
-    r11 = 1 - 2 * (x * x + z * z)
-    r12 = 2 * (y * z - w * x)
-    r22 = 1 - 2 * (x * x + y * y)
-    cy = jnp.sqrt(r22 * r22 + r12 * r12)
-    regular = cy > 1e-6
-    a = jnp.where(regular, -jnp.arctan2(r12, r22), 0.0)
-    b = -jnp.arctan2(-r02, cy)
-    c = jnp.where(regular, -jnp.arctan2(r01, r00), -jnp.arctan2(-r10, r11))
-    return jnp.stack([a, b, c])
-
-
-def quat_rotate(q: jax.Array, v: jax.Array) -> jax.Array:
-    """Rotate vector ``v`` by unit quaternion ``q`` (w, x, y, z)."""
-    w, u = q[0], q[1:]
-    return v + 2.0 * jnp.cross(u, jnp.cross(u, v) + w * v)
 
 
 def experimental(default, **metadata):
@@ -111,6 +66,10 @@ class _FetchTask(GoalEnv):
     substeps: int = 10
     iterations: int = 4
     ls_iterations: int = 4
+    # the physics: MJX with parts of its step replaced by faster equivalents, equal to float rounding, as the options
+    # below choose (kernels; envs/fetch/kernels.py), or MJX as it is (mjx). Stock MJX on a MuJoCo release other
+    # than the one the kernels were checked on (envs/physics.py).
+    physics: str = dataclasses.field(default="kernels", metadata={"numerics_only": True})
     # Parity-study options (experimental): the reference's variants of parts of the physics.
     # the table's collision shape: its top face as a plane, or the reference's box
     table: str = experimental("plane")
@@ -173,17 +132,11 @@ class _FetchTask(GoalEnv):
         check(self.table in tables, f"{n}.table", self.table, "one of " + ", ".join(tables))
         fingers = models.fingers_for(n)
         check(self.finger in fingers, f"{n}.finger", self.finger, "one of " + ", ".join(fingers))
-        spaces = models.WORKSPACES
+        spaces = control.WORKSPACES
         check(self.workspace in spaces, f"{n}.workspace", self.workspace, "one of " + ", ".join(spaces))
         check(self.drive in models.DRIVES, f"{n}.drive", self.drive, "one of " + ", ".join(models.DRIVES))
-        check(self.cholesky in CHOLESKY, f"{n}.cholesky", self.cholesky, "one of " + ", ".join(CHOLESKY))
-        ok = self.solver_loops in SOLVER_LOOPS
-        check(ok, f"{n}.solver_loops", self.solver_loops, "one of " + ", ".join(SOLVER_LOOPS))
-        check_integer(f"{n}.kernel_envs", self.kernel_envs, 0)
-        ok = self.kernel_warps in KERNEL_WARPS
-        check(ok, f"{n}.kernel_warps", self.kernel_warps, "one of " + ", ".join(map(str, KERNEL_WARPS)))
-        ok = self.collision in COLLISION
-        check(ok, f"{n}.collision", self.collision, "one of " + ", ".join(COLLISION))
+        check(self.physics in BACKENDS, f"{n}.physics", self.physics, "one of " + ", ".join(BACKENDS))
+        kernels.check_options(self)
         grasp_range = "in [0, 1]" if not self.block_gripper else "0 (the fingers are locked on this task)"
         ok = 0 <= self.grasped_starts <= 1 and (self.grasped_starts == 0 or not self.block_gripper)
         check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
@@ -237,45 +190,8 @@ class _FetchTask(GoalEnv):
         return self.built[2]
 
     # ---- observation -------------------------------------------------------------------------
-    def _grip_pos(self, qpos: jax.Array) -> jax.Array:
-        g = self.layout.grip_q
-        return jnp.asarray(self.layout.grip_home, qpos.dtype) + qpos[g : g + 3]
-
-    def _fingers(self, phys: Physics) -> tuple[jax.Array, jax.Array]:
-        lay = self.layout
-        if lay.finger_q is None:
-            z = jnp.zeros(2, phys.qpos.dtype)
-            return z, z
-        return phys.qpos[lay.finger_q : lay.finger_q + 2], phys.qvel[lay.finger_v : lay.finger_v + 2]
-
     def _observe(self, phys: Physics) -> tuple[jax.Array, jax.Array]:
-        """(observation, achieved goal) in the reference layout; velocities times dt."""
-        lay, dt = self.layout, self.dt
-        grip = self._grip_pos(phys.qpos)
-        grip_vel = phys.qvel[lay.grip_q : lay.grip_q + 3] * dt
-        finger_pos, finger_vel = self._fingers(phys)
-        finger_vel = finger_vel * dt
-        if not self.has_object:
-            return jnp.concatenate([grip, finger_pos, grip_vel, finger_vel]), grip
-        o, v = lay.object_q, lay.object_v
-        obj = phys.qpos[o : o + 3]
-        quat = phys.qpos[o + 3 : o + 7]
-        obj_vel = phys.qvel[v : v + 3] * dt
-        obj_rot_vel = quat_rotate(quat, phys.qvel[v + 3 : v + 6]) * dt  # free-joint angular velocity is local
-        obs = jnp.concatenate(
-            [
-                grip,
-                obj,
-                obj - grip,
-                finger_pos,
-                quat_to_euler(quat),
-                obj_vel - grip_vel,
-                obj_rot_vel,
-                grip_vel,
-                finger_vel,
-            ]
-        )
-        return obs, obj
+        return observation.observe(self.layout, self.dt, self.has_object, phys)
 
     def _state(self, phys: Physics, goal: jax.Array, step: jax.Array, invalid: jax.Array) -> State:
         obs, achieved = self._observe(phys)
@@ -344,7 +260,7 @@ class _FetchTask(GoalEnv):
         g = lay.grip_q
         reach = lay.reach_center if self.workspace == "arm" else None
         lo = (*lay.workspace_lo[:2], lay.workspace_lo[2] + self.floor_clearance)
-        target = models.gripper_target(phys.qpos[g : g + 3], action[:3], lay.grip_home, lo,
+        target = control.gripper_target(phys.qpos[g : g + 3], action[:3], lay.grip_home, lo,
                                        lay.workspace_hi, reach, xp=jnp)  # fmt: skip
         ctrl = phys.ctrl.at[0:3].set(target)
         if lay.finger_q is not None:
@@ -362,44 +278,19 @@ class _FetchTask(GoalEnv):
         if self.drive == "weld":  # the constraint pulls the gripper to the mocap body, put at the target
             home = jnp.asarray(self.layout.grip_home, data.mocap_pos.dtype)
             data = data.replace(mocap_pos=data.mocap_pos.at[0].set(home + ctrl[0:3]))
-        with self.solver_in_mjx():
-            return mjx_substeps(model, data, phys.replace(ctrl=ctrl), self.substeps)
+        step = functools.partial(mjx_substeps, model, data, phys.replace(ctrl=ctrl), self.substeps)
+        if self.physics_in_use() != "kernels":
+            return step()
+        with kernels.mjx_with_kernels(self):
+            return step()
+
+    def physics_in_use(self) -> str:
+        """The backend this task's steps run: its ``physics``, stock MJX on a MuJoCo the kernels were not
+        checked on (``envs/physics.py``)."""
+        return in_use(self.physics)
 
     def kernel_fallback(self, error: BaseException) -> str | None:
-        """The options that leave the physics' Triton kernels out, when a GPU's compiler failed on one (its error
-        names Triton)."""
-        own = (("solver_loops", "gpu-search"), ("collision", "mjx"))
-        options = [f"{name}={mjx_own}" for name, mjx_own in own if getattr(self, name) in KERNELS]
-        if not options or "triton" not in str(error).lower():
-            return None
-        first = str(error).strip().splitlines()[0][:200] if str(error).strip() else type(error).__name__
-        return f"{','.join(options)} (--env-options) on this GPU, whose compiler failed on a physics kernel ({first})"
-
-    @contextlib.contextmanager
-    def solver_in_mjx(self):
-        """Within the block (a trace of MJX calls), MJX factors, solves and collides boxes as this task's
-        ``cholesky``, ``solver_loops`` and ``collision`` choose (the kernels up to ``kernel_envs`` envs, with
-        ``kernel_warps`` warps per env), on the
-        backend being traced for."""
-        backend = jax.default_backend()
-        newton, line_search = solver_loops.writes_out(self.solver_loops, backend)
-        with (
-            small_cholesky.unrolled_in_mjx(self.cholesky == "unrolled"),
-            solver_loops.unrolled_in_mjx(self.iterations, newton, line_search),
-            fused_solver.fused_in_mjx(
-                runs_as_kernel(self.solver_loops, backend),
-                kernel=backend == "gpu",
-                max_envs=self.kernel_envs,
-                num_warps=self.kernel_warps,
-            ),
-            fused_collision.fused_in_mjx(
-                runs_as_kernel(self.collision, backend),
-                kernel=backend == "gpu",
-                max_envs=self.kernel_envs,
-                num_warps=self.kernel_warps,
-            ),
-        ):
-            yield
+        return kernels.kernel_fallback(self, error)
 
     def _action(self, action: jax.Array) -> jax.Array:
         """The action (any leading batch axes) as the control law reads it: clipped to [-1, 1], the fingers'

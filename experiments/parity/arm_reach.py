@@ -3,7 +3,7 @@
 The reference moves its gripper through a 7-joint arm pulled by a mocap weld; the gripper slows as
 the arm straightens and stops short of a target beyond the arm's reach. Ours has no arm: its xyz drive
 reaches any target in the workspace box, and ``workspace="arm"`` (the default) keeps each target
-within the reach this script measures (``envs.fetch.models.within_reach`` and ``ARM_REACH_*``).
+within the reach this script measures (``envs.fetch.control.within_reach`` and ``ARM_REACH_*``).
 
 Per robot placement (FetchSlide stands the robot 0.355 m further back than Push, PickAndPlace and
 Reach, which share one), the gripper is driven for 60 control steps at full action toward 36 far
@@ -93,11 +93,11 @@ def run_reference() -> dict:
 
 
 def run_ours(stretch_gain=None) -> dict:
-    """Our model and control rule (``models.gripper_target``, as the tasks step) in MuJoCo C, 10 steps of 4 ms each;
-    ``stretch_gain`` overrides ``models.ARM_STRETCH_GAIN``."""
-    from envs.fetch import models
+    """Our model and control rule (``control.gripper_target``, as the tasks step) in MuJoCo C, 10 steps of 4 ms each;
+    ``stretch_gain`` overrides ``control.ARM_STRETCH_GAIN``."""
+    from envs.fetch import control, models
 
-    gain = models.ARM_STRETCH_GAIN if stretch_gain is None else stretch_gain
+    gain = control.ARM_STRETCH_GAIN if stretch_gain is None else stretch_gain
     out = {}
     for kind in PLACEMENTS:
         m = mujoco.MjModel.from_xml_string(models.mjcf(kind, 0.004, 10, 4))
@@ -116,7 +116,7 @@ def run_ours(stretch_gain=None) -> dict:
             path = []
             for _ in range(STEPS):
                 a = np.clip((tgt - d.site_xpos[site]) / 0.05, -1, 1)
-                d.ctrl[0:3] = models.gripper_target(d.qpos[g : g + 3], a, home, lay.workspace_lo, lay.workspace_hi,
+                d.ctrl[0:3] = control.gripper_target(d.qpos[g : g + 3], a, home, lay.workspace_lo, lay.workspace_hi,
                                                     lay.reach_center, gain)
                 for _ in range(10):
                     mujoco.mj_step(m, d)

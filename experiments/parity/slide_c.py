@@ -56,7 +56,7 @@ def run(
     "arm" also keeps the gripper target within the reference arm's reach, "box" does not."""
     import jax
 
-    from envs.fetch import models, scripted
+    from envs.fetch import control, models, scripted
 
     m = mujoco.MjModel.from_xml_string(xml)
     m.opt.timestep = timestep
@@ -68,7 +68,7 @@ def run(
     home = np.asarray(models._SCENES["slide"][2])
     lo, hi = models.workspace_box("slide")
     rest_z = models.rest_height(m, o)
-    reach_center = models.ARM_REACH_CENTER["slide"] if workspace == "arm" else None
+    reach_center = control.ARM_REACH_CENTER["slide"] if workspace == "arm" else None
     obj_xy, goal_xy = starts(episodes, seed) if ep_starts is None else ep_starts
     goal = np.concatenate([goal_xy, np.full((episodes, 1), rest_z)], axis=1)
     ds = []
@@ -104,7 +104,7 @@ def run(
         for i, d in enumerate(ds):
             if bad[i]:
                 continue
-            d.ctrl[0:3] = models.gripper_target(d.qpos[g : g + 3], act[i, :3], home, lo, hi, reach_center)
+            d.ctrl[0:3] = control.gripper_target(d.qpos[g : g + 3], act[i, :3], home, lo, hi, reach_center)
             if m.nmocap:  # drive="weld": the constraint pulls the gripper to the mocap target
                 d.mocap_pos[0] = home + d.ctrl[0:3]
             for _ in range(substeps):

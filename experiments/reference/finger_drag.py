@@ -1,5 +1,5 @@
 """How far a gripper pressed on the table moves per control step, in ``FetchPush-v4`` and in our Push
-model with the finger-table contact (MuJoCo C, our control rule ``models.gripper_target``), for each
+model with the finger-table contact (MuJoCo C, our control rule ``control.gripper_target``), for each
 press depth given: the measurement that chose ``models.FINGER_PRESS``.
 
     PYTHONPATH=. python experiments/reference/finger_drag.py --press 0.02 0.025 0.03
@@ -12,7 +12,7 @@ import argparse
 import mujoco
 import numpy as np
 
-from envs.fetch import models
+from envs.fetch import control, models
 from splid_jax.reference.extra import make_reference
 
 ACTIONS = {"a_y = 1": (0, 1, 0), "a_y = 1, a_z = -0.3": (0, 1, -0.3), "a_y = 1, a_z = -1": (0, 1, -1),
@@ -42,8 +42,8 @@ def our_path(action, friction: float, press: float) -> np.ndarray:
     mujoco.mj_forward(m, d)
     path = [home + d.qpos[g : g + 3]]
     for _ in range(STEPS):
-        d.ctrl[0:3] = models.gripper_target(d.qpos[g : g + 3].copy(), np.array(action, float), home, lo, hi,
-                                            models.ARM_REACH_CENTER_DEFAULT)  # fmt: skip
+        d.ctrl[0:3] = control.gripper_target(d.qpos[g : g + 3].copy(), np.array(action, float), home, lo, hi,
+                                            control.ARM_REACH_CENTER_DEFAULT)  # fmt: skip
         for _ in range(SUBSTEPS):
             mujoco.mj_step(m, d)
         path.append(home + d.qpos[g : g + 3])

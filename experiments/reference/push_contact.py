@@ -1,5 +1,5 @@
 """How far and how straight a push moves the cube, in ``FetchPush-v4`` and in our Push model (MuJoCo C, our
-control rule ``models.gripper_target``), for each closed-finger shape given: the measurement that chose
+control rule ``control.gripper_target``), for each closed-finger shape given: the measurement that chose
 Push's ``finger="pads"``. From each one's home the cube is put ``GAP`` ahead of the grip along a direction
 (8 of them), shifted sideways by an offset, and pushed ``HOLD`` steps at two speeds, then left ``RELEASE``
 steps; per shape and speed, the mean over the cases of the cube's travel against the reference's, of the
@@ -15,8 +15,8 @@ import argparse
 import mujoco
 import numpy as np
 
-from envs.fetch import models
-from envs.fetch.tasks import quat_to_euler
+from envs.fetch import control, models
+from envs.fetch.rotations import quat_to_euler
 from splid_jax.reference.extra import make_reference
 from splid_jax.reference.mapping import reference_start
 
@@ -71,8 +71,8 @@ def our_pushes(finger: str) -> np.ndarray:
         mujoco.mj_forward(m, d)
         for t in range(HOLD + RELEASE):
             a = speed * ahead if t < HOLD else np.zeros(2)
-            d.ctrl[0:3] = models.gripper_target(d.qpos[g : g + 3].copy(), np.array([*a, 0.0]), home, lo, hi,
-                                                models.ARM_REACH_CENTER_DEFAULT)  # fmt: skip
+            d.ctrl[0:3] = control.gripper_target(d.qpos[g : g + 3].copy(), np.array([*a, 0.0]), home, lo, hi,
+                                                control.ARM_REACH_CENTER_DEFAULT)  # fmt: skip
             for _ in range(SUBSTEPS):
                 mujoco.mj_step(m, d)
         out.append([*(d.qpos[o : o + 2] - xy), _yaw(d.qpos[o + 3 : o + 7])])

@@ -4,9 +4,9 @@ take them) read into values, and checked against a dataclass field's declared ty
 from __future__ import annotations
 
 import dataclasses
-import math
 from typing import Any
 
+from envs.settings import typed_value
 from splid_jax.common.errors import InvalidConfig, check
 
 
@@ -38,33 +38,6 @@ def read_value(text: str) -> int | float | str:
             return float(text)
         except ValueError:
             return text
-
-
-def typed_value(where: str, kind: str, value):
-    """A setting (as ``read_value`` reads it) as its field's declared type ``kind``, or one error naming
-    ``where``: ``20.5`` is no integer, ``big`` no number. A tuple of integers arrives with colons
-    between its widths (``64:64``), since commas separate the settings."""
-    if kind == "bool":
-        words = {"true": True, "1": True, "false": False, "0": False}
-        if str(value).lower() not in words:
-            raise InvalidConfig(where, value, "true or false")
-        return words[str(value).lower()]
-    if kind.startswith("tuple"):
-        try:
-            return tuple(int(w) for w in str(value).split(":"))
-        except ValueError:
-            raise InvalidConfig(where, str(value).replace(":", ","), "comma-separated integers, e.g. 64,64") from None
-    if kind == "int":
-        if isinstance(value, int) and not isinstance(value, bool):
-            return value
-        raise InvalidConfig(where, value, "an integer")
-    if kind == "float":
-        if isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value):
-            return float(value)
-        raise InvalidConfig(where, value, "a finite number")
-    if kind == "str":
-        return str(value)
-    return value
 
 
 def parse_options(cls, text: str, field: str, prefix: str):

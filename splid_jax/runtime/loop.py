@@ -249,7 +249,8 @@ class _Loop:
                 write_atomic(os.path.join(lane.run_dir, METRICS), "")
         for i, lane in enumerate(self.lanes) if self.writes else ():
             placed = place.record(i if self.stacked else None, len(self.lanes))
-            write_json(os.path.join(lane.run_dir, "config.json"), {**lane.to_json(), "devices": placed})
+            record = {**lane.to_json(), "devices": placed, "physics": self.env.physics_in_use()}
+            write_json(os.path.join(lane.run_dir, "config.json"), record)
         if self.stacked and self.writes:
             named = [{**m.to_json(), "run_dir": os.path.basename(m.run_dir)} for m in self.lanes]
             write_json(os.path.join(cfg.run_dir, SWEEP), {"config": cfg.to_json(), "members": named})

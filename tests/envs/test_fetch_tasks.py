@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import envs
-from envs.fetch import models, scripted, tasks
+from envs.fetch import control, models, rotations, scripted, tasks
 from splid_jax.common.errors import InvalidConfig
 
 NAMES = ["reach", "push", "slide", "pick_and_place"]
@@ -153,14 +153,14 @@ def _target_after(env, grip_world, action):
 
 
 def test_slide_gripper_target_slows_near_the_arm_reach_and_stops_on_it():
-    center, radius = np.asarray(models.ARM_REACH_CENTER["slide"]), models.ARM_REACH_RADIUS
+    center, radius = np.asarray(control.ARM_REACH_CENTER["slide"]), control.ARM_REACH_RADIUS
     far = _target_after(_env("slide"), (1.38, 0.75, 0.42), (1.0, 0.0, -1.0, 0.0))
     assert np.linalg.norm(far - center) <= radius + 1e-6
     assert far[0] < 1.39 < 1.38 + 0.05  # the reference's gripper stops at x 1.39 here
     grip = np.array([1.30, 0.75, 0.42])  # 8 cm inside the reach
     near = _target_after(_env("slide"), grip, (1.0, 0.0, 0.0, 0.0))
     n = (grip - center) / np.linalg.norm(grip - center)
-    cap = models.ARM_STRETCH_GAIN * np.sqrt(radius - np.linalg.norm(grip - center))
+    cap = control.ARM_STRETCH_GAIN * np.sqrt(radius - np.linalg.norm(grip - center))
     np.testing.assert_allclose((near - grip) @ n, cap, rtol=1e-4)  # outward step capped, < the asked 5 cm
     inside = _target_after(_env("slide"), (1.0, 0.75, 0.45), (1.0, 0.0, -0.4, 0.0))
     np.testing.assert_allclose(inside, (1.05, 0.75, 0.43), atol=1e-6)  # well within reach: unchanged
@@ -171,14 +171,14 @@ def test_slide_gripper_target_slows_near_the_arm_reach_and_stops_on_it():
 def test_arm_reach_barely_touches_push_pick_and_reach_goal_regions():
     # their robot stands 0.355 m nearer the table than Slide's: every goal, and the pushing gripper 6 cm
     # behind it, lies over 20 cm inside the reach, where a full 5 cm step outward loses under 10 %
-    center, radius = np.asarray(models.ARM_REACH_CENTER_DEFAULT), models.ARM_REACH_RADIUS
+    center, radius = np.asarray(control.ARM_REACH_CENTER_DEFAULT), control.ARM_REACH_RADIUS
     g = np.stack(
         np.meshgrid(np.linspace(1.34 - 0.21, 1.34 + 0.15, 9), np.linspace(0.6, 0.9, 7), np.linspace(0.38, 0.9, 9)), -1
     ).reshape(-1, 3)
     assert (radius - np.linalg.norm(g - center, axis=1)).min() > 0.2
     for axis in range(3):
         steps = g + 0.05 * np.eye(3)[axis]
-        np.testing.assert_allclose(models.within_reach(g, steps, center), steps, atol=0.005)
+        np.testing.assert_allclose(control.within_reach(g, steps, center), steps, atol=0.005)
 
 
 def test_unknown_override_fails_naming_it():
@@ -202,7 +202,7 @@ def test_euler_angles_match_the_rotation():
         return jnp.concatenate([(w1 * w2 - v1 @ v2)[None], w1 * v2 + w2 * v1 + jnp.cross(v1, v2)])
 
     q = mul(mul(half([1.0, 0, 0], a), half([0, 1.0, 0], b)), half([0, 0, 1.0], c))  # R = Rx Ry Rz
-    np.testing.assert_allclose(tasks.quat_to_euler(q), [a, b, c], atol=1e-5)
+    np.testing.assert_allclose(rotations.quat_to_euler(q), [a, b, c], atol=1e-5)
 
 
 def _pairs(m: mujoco.MjModel) -> set[tuple[str, str]]:
@@ -433,8 +433,8 @@ def test_slide_gripper_driven_away_stops_on_the_arm_reach(fetch):
     acts = np.broadcast_to(np.array([1.0, 0.2, -1.0, 0.0]), (fetch.T, fetch.B, 4))
     _, _, traj = fetch.run(_env("slide"), acts)
     grip = np.asarray(traj.obs)[-1, :, 0:3]
-    dist = np.linalg.norm(grip - np.asarray(models.ARM_REACH_CENTER["slide"]), axis=1)
-    np.testing.assert_allclose(dist, models.ARM_REACH_RADIUS, atol=0.01)
+    dist = np.linalg.norm(grip - np.asarray(control.ARM_REACH_CENTER["slide"]), axis=1)
+    np.testing.assert_allclose(dist, control.ARM_REACH_RADIUS, atol=0.01)
     assert grip[:, 0].max() < 1.41  # the reference's gripper reaches x 1.39 at table height
 
 

@@ -13,10 +13,10 @@ from mujoco.mjx._src import collision_convex, collision_driver, math, mesh
 from mujoco.mjx._src.collision_types import GeomInfo
 
 import envs
-from envs import fused_collision
+from envs import box_contacts, fused_collision
+from envs.fetch.kernels import runs_as_kernel
 from envs.fetch.scripted import CONTROLLERS
-from envs.fetch.tasks import runs_as_kernel
-from tests.helpers import triton_calls_in_step
+from tests.helpers import needs_kernels, triton_calls_in_step
 
 
 def _rotation(q):
@@ -62,7 +62,7 @@ def _contacts(dist, pos, i):
 def test_box_box_makes_mjxs_contacts():
     args = _pairs(90)
     want = jax.jit(_mjx)(*args)
-    got = jax.jit(jax.vmap(fused_collision.box_box))(*args)
+    got = jax.jit(jax.vmap(box_contacts.box_box))(*args)
     np.testing.assert_allclose(got[2], want[2], atol=1e-5)  # the normal's frame: the same separating axis
     touching = np.asarray(want[0] < 0).any(axis=1)
     assert touching.sum() > 50
@@ -74,8 +74,8 @@ def test_kernels_are_the_functions_and_lower_as_one_triton_call_each():
     args = _pairs(12, seed=1)
     plane = (args[3], args[4], *args[:3])  # the second box's frame as a plane, the first box on it
     cases = [
-        (fused_collision.box_box, fused_collision.kernel_box_box, args),
-        (fused_collision.plane_box, fused_collision.kernel_plane_box, plane),
+        (box_contacts.box_box, fused_collision.kernel_box_box, args),
+        (box_contacts.plane_box, fused_collision.kernel_plane_box, plane),
     ]
     for function, kernel_fn, inputs in cases:
         plain = jax.jit(jax.vmap(function))(*inputs)
@@ -125,15 +125,14 @@ def test_push_path_follows_mjxs():
     np.testing.assert_allclose(fused, base, atol=1e-5)
 
 
-def test_driver_keeps_mjxs_function_outside_the_block():
-    before = dict(collision_driver._COLLISION_FUNC)
-    with fused_collision.fused_in_mjx():
-        swapped = {k for k, f in collision_driver._COLLISION_FUNC.items() if f is not before[k]}
-        assert swapped == {(0, 6), (6, 6)}  # plane-box and box-box
-    assert collision_driver._COLLISION_FUNC == before
+def test_the_driver_is_given_the_plane_box_and_box_box_groups_alone():
+    groups = fused_collision.groups()
+    assert set(groups) == {(0, 6), (6, 6)} and {g.ncon for g in groups.values()} == {4}  # four contacts a pair
+    assert set(groups) <= set(collision_driver._COLLISION_FUNC)
     assert [runs_as_kernel("gpu-fused", b) for b in ("gpu", "cpu")] == [True, False]
 
 
+@needs_kernels
 def test_push_collides_boxes_in_kernels_on_a_gpu_by_default(monkeypatch):
     env = envs.make("push", substeps=1)
     assert triton_calls_in_step(env, monkeypatch) == (0, 3)  # plane-box and box-box contacts, the constraint solve

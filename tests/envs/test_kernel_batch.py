@@ -13,9 +13,10 @@ from mujoco.mjx._src import solver as mjx_solver
 import envs
 from envs import fused_solver, kernel_batch
 from splid_jax.common.errors import InvalidConfig
-from tests.helpers import triton_calls_for_gpu
+from tests.helpers import needs_kernels, triton_calls_for_gpu
 
 
+@needs_kernels
 def test_kernels_take_batches_up_to_the_limit_and_xla_larger_ones(monkeypatch):
     # one env per program loses to batched operations at thousands of envs; a sweep's members (the outer axis)
     # do not count against the limit, the envs of one step (the inner axis) do
@@ -26,6 +27,7 @@ def test_kernels_take_batches_up_to_the_limit_and_xla_larger_ones(monkeypatch):
         envs.make("push", kernel_envs=-1)
 
 
+@needs_kernels
 def test_a_batch_above_the_limit_is_mjxs_own_solve():
     env = envs.make("push")
     model = env.mjx_model
@@ -52,6 +54,7 @@ def test_no_limit_keeps_the_kernel_function_itself():
     np.testing.assert_array_equal(jax.vmap(jax.vmap(limited))(jnp.ones((3, 2))), np.full((3, 2), 2.0))
 
 
+@needs_kernels
 def test_every_physics_kernel_takes_the_tasks_warps(monkeypatch):
     # one warp per env is the faster kernel at every batch measured (BENCHMARKS.md); 4 is Triton's default
     from jax.experimental.pallas import triton as pl_triton

@@ -1,5 +1,5 @@
 """The unrolled Cholesky that MJX steps use: equal to jax.scipy.linalg's to float rounding, in
-effect only inside its block, and live in a Push step (no library Cholesky left in its program)."""
+and live in a Push step (no library Cholesky left in its program)."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ import pytest
 
 import envs
 from envs import small_cholesky
+from tests.helpers import needs_kernels
 
 
 def _spd(n, seed):
@@ -41,18 +42,7 @@ def test_large_or_batched_matrices_go_to_the_library():
     np.testing.assert_array_equal(small_cholesky.cho_factor(batch)[0], jsl.cho_factor(batch)[0])
 
 
-def test_substitution_holds_only_inside_the_block():
-    library = (jsl.cho_factor, jsl.cho_solve)
-    with small_cholesky.unrolled_in_mjx():
-        assert (jsl.cho_factor, jsl.cho_solve) == (small_cholesky.cho_factor, small_cholesky.cho_solve)
-        with small_cholesky.unrolled_in_mjx(False):
-            assert jsl.cho_factor is small_cholesky.cho_factor
-    assert (jsl.cho_factor, jsl.cho_solve) == library
-    with pytest.raises(RuntimeError), small_cholesky.unrolled_in_mjx():
-        raise RuntimeError("a failed trace")
-    assert (jsl.cho_factor, jsl.cho_solve) == library
-
-
+@needs_kernels
 @pytest.mark.slow
 def test_push_step_has_no_library_cholesky_and_steps_alike(fetch, primitives):
     fast, library = envs.make("push"), envs.make("push", cholesky="library")

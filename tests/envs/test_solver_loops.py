@@ -12,6 +12,7 @@ import pytest
 
 import envs
 from envs import solver_loops
+from tests.helpers import needs_kernels
 
 
 @functools.cache
@@ -57,6 +58,7 @@ def _loop_primitives(choice: str | None = None) -> set[str]:
     return {p for p, n in counts.items() if n > 0}
 
 
+@needs_kernels
 def test_written_out_solver_leaves_no_loop_in_the_step():
     assert _loop_primitives("loops") == {"while[", "scan["}  # Newton, its line search, the substeps
     assert _loop_primitives("unrolled") == {"scan["}  # the substeps' loop alone
@@ -64,6 +66,7 @@ def test_written_out_solver_leaves_no_loop_in_the_step():
     assert _loop_primitives() == {"while[", "scan["}  # the default, gpu-search: the loops on the CPU
 
 
+@needs_kernels
 def test_written_out_line_search_keeps_the_newton_loop_alone():
     counts = _loop_counts(str(_program("search")[0].jaxpr), episode_scans=1)
     assert counts == {"while[": 1, "scan[": 1}  # the Newton loop and the substeps'
@@ -86,13 +89,11 @@ def test_written_out_solver_follows_the_loops_path(choice):
     np.testing.assert_allclose(written, loops, atol=1e-5)
 
 
-def test_only_the_solvers_loops_are_swapped_and_only_inside_the_block():
-    before = jax.lax.while_loop
-    with solver_loops.unrolled_in_mjx(iterations=3):
-        # a loop that is not the solver's keeps its own trip count
-        n = jax.jit(lambda x: jax.lax.while_loop(lambda i: i < 10, lambda i: i + 1, x))(jnp.int32(0))
+def test_only_the_solvers_loops_are_written_out():
+    # a loop that is not the solver's keeps its own trip count
+    loop = solver_loops.solver_while(iterations=3)
+    n = jax.jit(lambda x: loop(lambda i: i < 10, lambda i: i + 1, x))(jnp.int32(0))
     assert int(n) == 10
-    assert jax.lax.while_loop is before
 
 
 def test_settings_record_the_written_out_solver_only_when_chosen():

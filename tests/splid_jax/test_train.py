@@ -263,6 +263,7 @@ def test_env_options_build_the_task_the_run_trains_on(tmp_path):
     assert main([*args, "--env-options", "max_episode_steps=20,success_radius=0.5", "--quiet"]) == 0
     cfg = json.load(open(run_dir / "config.json"))
     assert cfg["env_options"] == "max_episode_steps=20,success_radius=0.5"
+    assert cfg["physics"] is None  # the point task has no choice of physics code; a Fetch task records its own
     rec = json.loads(open(run_dir / "metrics.jsonl").readline())
     assert rec["env_steps"] == 5 * 4 * 20  # episodes of the overridden length
 

@@ -1,0 +1,48 @@
+"""The gripper target each control step sets: ``TARGET_STEP`` per unit action from where the gripper is, clipped to
+the task's workspace box, then kept within the reference arm's reach. The one rule of the tasks and of the MuJoCo
+C replicas in ``experiments/``."""
+
+from __future__ import annotations
+
+import numpy as np
+
+# The reference arm's reach (experiments/parity/arm_reach.py). Its grip site, pulled by the mocap weld
+# toward a target out of reach, stops on a sphere around a point near the shoulder (36 stops per robot
+# placement fit it to 0.7 mm), and slows as the arm straightens: near the sphere it gains at most about
+# ARM_STRETCH_GAIN * sqrt(distance left) outward per control step, as a two-link arm near full
+# extension does. FetchSlide stands the robot 0.355 m further back than the other tasks, so only
+# Slide's goals (x up to 1.71) lie beyond it: its gripper reaches x 1.39 at table height.
+ARM_REACH_RADIUS = 1.126
+ARM_REACH_CENTER = {"slide": (0.319, 0.744, 0.781)}
+ARM_REACH_CENTER_DEFAULT = (0.674, 0.744, 0.781)
+ARM_STRETCH_GAIN = 0.10  # m^0.5 per control step: the target's outward step is capped at this * sqrt(R - r)
+WORKSPACES = ("arm", "box")
+TARGET_STEP = 0.05  # metres of gripper target motion per unit action per control step
+
+
+def within_reach(grip, target, center, radius=ARM_REACH_RADIUS, stretch_gain=ARM_STRETCH_GAIN, xp=np):
+    """The gripper target (world xyz, [..., 3]) the reference arm would follow from ``grip``: its step
+    away from ``center`` capped at ``stretch_gain * sqrt(radius - r)`` (r: the grip's distance from
+    ``center``), then moved onto the ball of ``radius`` if outside it. ``xp``: numpy or jax.numpy."""
+    center = xp.asarray(center)
+    off = grip - center
+    r = xp.sqrt(xp.sum(off * off, axis=-1, keepdims=True))
+    n = off / xp.maximum(r, 1e-9)
+    outward = xp.sum((target - grip) * n, axis=-1, keepdims=True)
+    cap = stretch_gain * xp.sqrt(xp.maximum(radius - r, 0.0))
+    target = target - n * xp.maximum(outward - cap, 0.0)
+    off = target - center
+    dist = xp.sqrt(xp.sum(off * off, axis=-1, keepdims=True))
+    return center + off * xp.minimum(1.0, radius / xp.maximum(dist, 1e-9))
+
+
+def gripper_target(q, action_xyz, home, lo, hi, reach_center=None, stretch_gain=ARM_STRETCH_GAIN, xp=np):
+    """The xyz drive's next target in the gripper joints' coordinates (grip site = ``home`` + ``q``), as
+    each control step sets it: ``TARGET_STEP * action_xyz`` from where the gripper is, clipped to the
+    world box [``lo``, ``hi``], then kept within the reference arm's reach around ``reach_center``
+    (``within_reach``) unless that is None. The one rule of the tasks and of the C replicas."""
+    home = xp.asarray(home)
+    target = xp.clip(q + TARGET_STEP * action_xyz, xp.asarray(lo) - home, xp.asarray(hi) - home)
+    if reach_center is not None:
+        target = within_reach(q + home, target + home, reach_center, stretch_gain=stretch_gain, xp=xp) - home
+    return target
