@@ -139,7 +139,8 @@ def rollout(env, policy, pstate, key, episodes: int):
 
 
 def paths_figure(env, states, title: str):
-    """The episodes' achieved-goal paths in x-y, green where the goal was reached, red where not."""
+    """The episodes' achieved-goal paths in x-y: each episode's start, path and goal in a colour of its own, the
+    path solid where the goal was reached and dashed where not."""
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch, Rectangle
@@ -150,10 +151,10 @@ def paths_figure(env, states, title: str):
     fig = Figure(figsize=(6, 6.6))
     ax = fig.add_subplot()
     legend = [
-        Line2D([], [], color="tab:green", lw=1.2, label="reached its goal"),
-        Line2D([], [], color="tab:red", lw=1.2, label="did not"),
+        Line2D([], [], color="0.3", lw=1.2, label="reached its goal"),
+        Line2D([], [], color="0.3", lw=1.2, ls="--", label="did not"),
         Line2D([], [], ls="", marker="o", color="0.3", ms=4, label="start"),
-        Line2D([], [], ls="", marker="*", color="k", ms=9, label="goal"),
+        Line2D([], [], ls="", marker="*", color="0.3", mec="k", ms=10, label="goal"),
     ]
     if hasattr(env, "boxes"):  # the point task: draw its walls
         for x0, x1, y0, y1 in np.asarray(env.boxes):
@@ -161,11 +162,12 @@ def paths_figure(env, states, title: str):
         ax.set_xlim(-5, 5)
         ax.set_ylim(-5, 5)
         legend.append(Patch(color="0.5", label="wall"))
+    palette = [f"C{i}" for i in range(10)]
     for e in range(ag.shape[1]):
-        colour = "tab:green" if succ[e] else "tab:red"
-        ax.plot(ag[:, e, 0], ag[:, e, 1], "-", color=colour, lw=1.2)
+        colour = palette[e % len(palette)]
+        ax.plot(ag[:, e, 0], ag[:, e, 1], "-" if succ[e] else "--", color=colour, lw=1.2)
         ax.plot(ag[0, e, 0], ag[0, e, 1], "o", color=colour, ms=4)
-        ax.plot(goal[e, 0], goal[e, 1], "*", color="k", ms=9)
+        ax.plot(goal[e, 0], goal[e, 1], "*", color=colour, mec="k", mew=0.6, ms=10)
     ax.set_aspect("equal")
     ax.set_title(title)
     ax.set_xlabel("x of the achieved goal")

@@ -201,6 +201,24 @@ def test_paths_figure_has_a_title_and_a_legend():
     assert [t.get_text() for t in legend.get_texts()] == ["reached its goal", "did not", "start", "goal", "wall"]
 
 
+def test_paths_figure_links_each_episodes_start_path_and_goal_by_colour():
+    from types import SimpleNamespace
+
+    from matplotlib.colors import to_rgba
+
+    ag = np.stack([np.linspace(0, 1, 4), np.zeros(4)], -1)[:, None] + np.array([[0.0, 0.0], [0.0, 2.0]])[None]
+    goal = np.broadcast_to(np.array([[1.0, 0.0], [3.0, 2.0]]), (4, 2, 2))
+    success = np.array([[0, 0], [0, 0], [1, 0], [1, 0]], bool)  # the first reaches its goal, the second does not
+    states = SimpleNamespace(achieved_goal=ag, desired_goal=goal, success=success)
+    lines = rollout.paths_figure(make_env("point"), states, "t").axes[0].get_lines()
+    assert len(lines) == 6  # path, start, goal per episode
+    for e, (path, start, star) in enumerate(zip(lines[0::3], lines[1::3], lines[2::3], strict=True)):
+        assert to_rgba(path.get_color()) == to_rgba(start.get_color()) == to_rgba(star.get_color())
+        np.testing.assert_allclose(star.get_xydata()[0], goal[0, e])
+        assert path.get_linestyle() == ("-" if e == 0 else "--")
+    assert to_rgba(lines[0].get_color()) != to_rgba(lines[3].get_color())
+
+
 @pytest.mark.parametrize(
     "algo,options",
     [
