@@ -130,7 +130,7 @@ def test_a_tensorboard_dir_that_cannot_be_written_is_refused_before_any_work(tmp
     argv = ["--env", "point", "--iterations", "5", "--run-dir", str(tmp_path / "run"), "--tensorboard", log_dir]
     assert importlib.import_module(f"splid_jax.{command}").main(argv) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "invalid tensorboard=" in err and "writable" in err
+    assert len(err.splitlines()) == 1 and "invalid --tensorboard " in err and "writable" in err
     assert not (tmp_path / "run").exists()
 
 
