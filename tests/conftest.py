@@ -25,6 +25,7 @@ pytest_plugins = ("tests.hang_watchdog",)  # a test that hangs ends its worker, 
 # since an unknown XLA flag aborts the process.
 # LLVM's optimisation level 0 compiles a Fetch episode program in 3.5 s instead of 5.6 s and runs it
 # 3x slower, a trade the suite's tiny programs win.
+SHARED_CACHE = "SPLID_JAX_TEST_CACHE_HOME"
 CPU_COMPILE_FLAGS = ("--xla_cpu_use_fusion_emitters=false", "--xla_backend_optimization_level=0")
 
 
@@ -40,7 +41,12 @@ def pytest_configure(config):
     _faster_cpu_compiles()  # before the first compilation; subprocesses and workers inherit it
     # Before the first compilation: the run neither reads nor writes the user's ~/.cache (JAX's
     # programs, the CLI's default --compile-cache, subprocesses' caches), and starts cold every time.
-    config.splid_cache_home = tempfile.mkdtemp(prefix="splid-jax-tests-")
+    # xdist's workers share the cache of the run that started them, so a program one worker compiled
+    # is loaded by the other.
+    shared = os.environ.get(SHARED_CACHE) if hasattr(config, "workerinput") else None
+    config.splid_cache_home = shared or tempfile.mkdtemp(prefix="splid-jax-tests-")
+    config.splid_owns_cache = shared is None
+    os.environ[SHARED_CACHE] = config.splid_cache_home
     os.environ["XDG_CACHE_HOME"] = config.splid_cache_home
     from splid_jax.cli import default_compile_cache
 
@@ -53,7 +59,8 @@ def pytest_configure(config):
 
 
 def pytest_unconfigure(config):
-    shutil.rmtree(config.splid_cache_home, ignore_errors=True)
+    if getattr(config, "splid_owns_cache", False):
+        shutil.rmtree(config.splid_cache_home, ignore_errors=True)
 
 
 # Test files that step the same compiled programs (``FetchEpisodes``'s Push program below): one xdist
@@ -67,27 +74,27 @@ SHARED_PROGRAMS = {
 # first, longest first, so the last units handed out are short and the two workers end together (in
 # the order of collection, a worker once sat idle for the last 90 s). Only the order depends on these.
 UNIT_SECONDS = {
-    "fetch-episodes": 190,
-    "tests/splid_jax/test_train.py": 100,
-    "tests/envs/test_solver_loops.py": 55,
-    "tests/splid_jax/reference/test_cli.py": 48,
-    "tests/splid_jax/learners/test_algos.py": 45,
-    "tests/splid_jax/runtime/test_devices.py": 40,
-    "tests/splid_jax/learners/her/test_her.py": 40,
-    "tests/splid_jax/runtime/test_multihost.py": 37,
-    "tests/splid_jax/test_rollout.py": 36,
-    "tests/splid_jax/test_sweep.py": 31,
-    "tests/splid_jax/learners/splid/test_trainer.py": 29,
-    "tests/envs/test_reacher.py": 29,
-    "tests/splid_jax/runtime/test_run_files.py": 25,
-    "tests/splid_jax/test_figures.py": 22,
-    "tests/splid_jax/learners/test_gcsl.py": 15,
-    "tests/envs/test_base.py": 15,
-    "tests/splid_jax/reference/test_response.py": 15,
-    "tests/splid_jax/learners/test_es.py": 13,
-    "tests/splid_jax/test_tensorboard.py": 13,
-    "tests/splid_jax/learners/splid/test_select.py": 12,
-    "tests/envs/test_sawyer_door.py": 10,
+    "fetch-episodes": 86,
+    "tests/envs/test_fused_collision.py": 58,
+    "tests/splid_jax/test_train.py": 51,
+    "tests/splid_jax/learners/her/test_her.py": 43,
+    "tests/envs/test_fused_solver.py": 33,
+    "tests/splid_jax/runtime/test_run_files.py": 27,
+    "tests/envs/test_kernel_batch.py": 26,
+    "tests/envs/test_solver_loops.py": 26,
+    "tests/splid_jax/reference/test_cli.py": 24,
+    "tests/splid_jax/runtime/test_multihost.py": 22,
+    "tests/splid_jax/test_figures.py": 21,
+    "tests/splid_jax/learners/splid/test_trainer.py": 21,
+    "tests/splid_jax/test_rollout.py": 20,
+    "tests/splid_jax/learners/test_algos.py": 19,
+    "tests/splid_jax/runtime/test_devices.py": 18,
+    "tests/splid_jax/runtime/test_programs.py": 15,
+    "tests/splid_jax/test_sweep.py": 14,
+    "tests/splid_jax/runtime/test_loop.py": 12,
+    "tests/envs/test_reacher.py": 12,
+    "tests/test_hang_watchdog.py": 11,
+    "tests/splid_jax/learners/test_es.py": 9,
 }
 
 
