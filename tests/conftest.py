@@ -25,7 +25,6 @@ pytest_plugins = ("tests.hang_watchdog",)  # a test that hangs ends its worker, 
 # since an unknown XLA flag aborts the process.
 # LLVM's optimisation level 0 compiles a Fetch episode program in 3.5 s instead of 5.6 s and runs it
 # 3x slower, a trade the suite's tiny programs win.
-SHARED_CACHE = "SPLID_JAX_TEST_CACHE_HOME"
 CPU_COMPILE_FLAGS = ("--xla_cpu_use_fusion_emitters=false", "--xla_backend_optimization_level=0")
 
 
@@ -41,12 +40,7 @@ def pytest_configure(config):
     _faster_cpu_compiles()  # before the first compilation; subprocesses and workers inherit it
     # Before the first compilation: the run neither reads nor writes the user's ~/.cache (JAX's
     # programs, the CLI's default --compile-cache, subprocesses' caches), and starts cold every time.
-    # xdist's workers share the cache of the run that started them, so a program one worker compiled
-    # is loaded by the other.
-    shared = os.environ.get(SHARED_CACHE) if hasattr(config, "workerinput") else None
-    config.splid_cache_home = shared or tempfile.mkdtemp(prefix="splid-jax-tests-")
-    config.splid_owns_cache = shared is None
-    os.environ[SHARED_CACHE] = config.splid_cache_home
+    config.splid_cache_home = tempfile.mkdtemp(prefix="splid-jax-tests-")
     os.environ["XDG_CACHE_HOME"] = config.splid_cache_home
     from splid_jax.cli import default_compile_cache
 
@@ -59,8 +53,7 @@ def pytest_configure(config):
 
 
 def pytest_unconfigure(config):
-    if getattr(config, "splid_owns_cache", False):
-        shutil.rmtree(config.splid_cache_home, ignore_errors=True)
+    shutil.rmtree(config.splid_cache_home, ignore_errors=True)
 
 
 # Test files that step the same compiled programs (``FetchEpisodes``'s Push program below): one xdist
