@@ -20,16 +20,16 @@ from splid_jax import presets
 from splid_jax.common.errors import check
 from splid_jax.common.fields import field
 from splid_jax.common.paths import is_utf8
-from splid_jax.common.values import format_overrides, merged_options, options_text, parse_options, parse_overrides
+from splid_jax.common.values import format_overrides, merged_options, parse_overrides
 from splid_jax.learners import registry
+from splid_jax.learners.her.config import DEFAULTS as HER_DEFAULTS
+from splid_jax.learners.her.config import HerConfig
 from splid_jax.learners.imitation.config import ImitationConfig
 
 CLONING = frozenset(f.name for f in dataclasses.fields(ImitationConfig))
 MAX_ITERATIONS = 10**7  # far beyond any run's budget: a larger value is a typo, and would run for ever
-# Keys a run's config.json holds beside the fields: where it ran, the physics code it ran, and which defaults its
-# learner's options are read against (HER's defaults were Baselines' before they became mrl's).
-PROVENANCE = ("devices", "her_defaults", "physics")
-HER_DEFAULTS = "mrl"
+# Keys a run's config.json holds beside the fields: where it ran, and the physics code it ran.
+PROVENANCE = ("devices", "physics")
 # Settings runs were once recorded with that left the package (experiments/NOTES.md, "Retired options"): a
 # config.json holding one at its neutral value loads without it, one at another value is refused
 RETIRED = {"hold_horizon": 0, "rest_horizon": 0, "select_radius": 1.0, "held_share": 0.0}
@@ -114,6 +114,13 @@ class TrainConfig:
     her_options: str = field(
         "", "her only: HER's settings as KEY=VALUE[,KEY=VALUE...], as the --her-* flags give them to config.json"
     )
+    her_defaults: str | None = field(
+        None,
+        "her only: the defaults her_options are read against: mrl (HerConfig's, the default) or baselines "
+        "(HerConfig's BASELINES, HER's defaults when runs recorded without this setting were made)",
+        recorded_when_set=True,
+        unrecorded="baselines",
+    )
     es_options: str = field(
         "", "es only: ES's settings as KEY=VALUE[,KEY=VALUE...], as the --es-* flags give them to config.json"
     )
@@ -168,10 +175,7 @@ class TrainConfig:
 
     def to_json(self) -> dict[str, Any]:
         """The settings flat, as config.json holds them."""
-        saved = {f.name: getattr(self, f.name) for f in self.settings_fields()}
-        if self.algo == "her":
-            saved["her_defaults"] = HER_DEFAULTS
-        return saved
+        return {f.name: getattr(self, f.name) for f in self.settings_fields()}
 
     @classmethod
     def unrecorded_values(cls) -> dict[str, Any]:
@@ -185,8 +189,8 @@ class TrainConfig:
         task gained a default option resumes as it ran; a setting added since reads as those runs behaved
         (its ``unrecorded`` value)."""
         unrecorded = cls.unrecorded_values()
-        if saved.get("algo") == "her" and saved.get("her_defaults") != HER_DEFAULTS and "her_options" not in changes:
-            saved = {**saved, "her_options": _on_baselines(saved.get("her_options", ""))}
+        if saved.get("algo") != "her":  # what HER's options were read against concerns HER's runs alone
+            unrecorded.pop("her_defaults")
         for name, value in RETIRED.items():
             allowed = f"a run this version can resume: its {name}={saved.get(name)!r} left the package"
             check(saved.get(name, value) == value, "resume", saved.get("run_dir"), allowed)
@@ -206,6 +210,11 @@ def _resolve(c) -> None:
         check(value is None or _is_a(value, f.type), f.name, value, _KINDS.get(f.type, f.type))
     check(c.env in envs.names(), "env", c.env, "one of " + ", ".join(envs.names()))
     learner = registry.get(c.algo)
+    if learner.settings is HerConfig:  # runs recorded before the setting read "baselines" (from_json)
+        c.her_defaults = c.her_defaults or "mrl"
+        check(c.her_defaults in HER_DEFAULTS, "her_defaults", c.her_defaults, " or ".join(HER_DEFAULTS))
+    her = learner.settings is HerConfig
+    check(her or c.her_defaults is None, "her_defaults", c.her_defaults, "unset unless algo=her")
     for other in registry.LEARNERS.values():  # each learner's own settings, refused for another
         text = getattr(c, other.options) if other.options else ""
         check(not text or other is learner, other.options, text, f"empty unless algo={other.name}")
@@ -278,15 +287,3 @@ def _resolve(c) -> None:
     check(c.run_dir.strip() != "", "run_dir", c.run_dir, "a directory name, not empty")
     check(is_utf8(c.run_dir), "run_dir", c.run_dir, "a path of UTF-8 text (checkpoints are written by it)")
     check(not os.path.isfile(c.run_dir), "run_dir", c.run_dir, "a directory, not an existing file")
-
-
-def _on_baselines(text: Any) -> Any:
-    """A run's HER options, recorded against the Baselines defaults, as text against today's defaults."""
-    from splid_jax.learners.her.config import BASELINES, HerConfig
-
-    if not isinstance(text, str):
-        return text  # refused by the construction, naming the field
-    recorded = parse_options(HerConfig, text, "her_options", "her")
-    given = {part.partition("=")[0].strip() for part in text.split(",") if "=" in part}
-    changed = {name: getattr(recorded, name) for name in given}
-    return options_text(HerConfig(), **{**BASELINES, **changed})

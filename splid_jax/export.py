@@ -34,7 +34,8 @@ def without_buffer(cfg, env):
     if isinstance(settings, ImitationConfig):
         return dataclasses.replace(cfg, buffer_size=1, buffer_window=0, buffer_window_grow=0)
     if isinstance(settings, HerConfig):
-        return dataclasses.replace(cfg, her_options=options_text(settings, buffer_transitions=env.episode_length))
+        text = options_text(settings, buffer_transitions=env.episode_length)  # against HerConfig's own defaults
+        return dataclasses.replace(cfg, her_options=text, her_defaults="mrl")
     return cfg  # ES keeps no buffer
 
 

@@ -66,8 +66,7 @@ def options_text(settings, **changed) -> str:
     values = {f.name: getattr(settings, f.name) for f in dataclasses.fields(settings)}
     values.update(changed)
     defaults = {f.name: f.default for f in dataclasses.fields(settings)}
-    show = lambda v: ",".join(map(str, v)) if isinstance(v, tuple) else str(v)  # noqa: E731
-    return ",".join(f"{k}={show(v)}" for k, v in values.items() if v != defaults[k])
+    return ",".join(f"{k}={_shown(v)}" for k, v in values.items() if v != defaults[k])
 
 
 def merged_options(cls, base: str, given: str, field: str, prefix: str) -> str:
@@ -78,8 +77,12 @@ def merged_options(cls, base: str, given: str, field: str, prefix: str) -> str:
         settings = parse_options(cls, text, field, prefix)
         keys = [part.partition("=")[0].strip() for part in text.split(",") if "=" in part]
         values.update({key: getattr(settings, key) for key in keys})
-    show = lambda v: ",".join(map(str, v)) if isinstance(v, tuple) else str(v)  # noqa: E731
-    return ",".join(f"{key}={show(value)}" for key, value in values.items())
+    return ",".join(f"{key}={_shown(value)}" for key, value in values.items())
+
+
+def _shown(value) -> str:
+    """A setting as options text writes it: a tuple's widths comma-separated (``hidden=64,64``)."""
+    return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
 
 
 def typed_fields(cls, values: dict[str, Any], prefix: str) -> dict[str, Any]:

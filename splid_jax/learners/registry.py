@@ -11,8 +11,9 @@ import importlib
 from typing import Any
 
 from splid_jax.common.errors import InvalidConfig, check
-from splid_jax.common.values import parse_options
+from splid_jax.common.values import merged_options, options_text, parse_options
 from splid_jax.learners.es.config import EsConfig
+from splid_jax.learners.her.config import DEFAULTS as HER_DEFAULTS
 from splid_jax.learners.her.config import HerConfig
 from splid_jax.learners.imitation.config import ImitationConfig
 
@@ -107,7 +108,11 @@ def settings(cfg) -> Any:
     """The learner's own settings from the run config ``cfg`` (a ``config.TrainConfig``), validated."""
     learner = get(cfg.algo)
     if learner.options is not None:
-        return parse_options(learner.settings, getattr(cfg, learner.options), learner.options, learner.name)
+        text = getattr(cfg, learner.options)
+        if learner.settings is HerConfig and HER_DEFAULTS[cfg.her_defaults]:  # recorded against other defaults
+            base = options_text(HerConfig(), **HER_DEFAULTS[cfg.her_defaults])
+            text = merged_options(HerConfig, base, text, learner.options, learner.name)
+        return parse_options(learner.settings, text, learner.options, learner.name)
     return learner.settings(**{name: getattr(cfg, name) for name in IMITATION_FIELDS})  # resolved: flat or nested
 
 

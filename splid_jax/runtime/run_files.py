@@ -38,13 +38,16 @@ def note_task_changes(run_dir: str, saved: dict, env: envs.GoalEnv) -> None:
 
 def identity(cfg: TrainConfig) -> dict:
     """The settings a checkpoint must share with the run resuming it, as JSON stores them. A setting
-    added after runs were recorded (field metadata ``recorded_when_set``) is left out at its default (or at
-    its ``unrecorded`` value, where the default is resolved per task), which is how those runs behaved, so
-    they still resume."""
+    added after runs were recorded (field metadata ``recorded_when_set``) is left out at its default and at
+    its ``unrecorded`` value (how those runs behaved), so they still resume."""
     fields = cfg.settings_fields()
-    later = {f.name: f.metadata.get("unrecorded", f.default) for f in fields if f.metadata.get("recorded_when_set")}
+    later = {
+        f.name: (f.metadata.get("unrecorded", f.default), f.default)
+        for f in fields
+        if f.metadata.get("recorded_when_set")
+    }
     kept = {
-        k: v for k, v in cfg.to_json().items() if k not in MAY_CHANGE_ON_RESUME and not (k in later and v == later[k])
+        k: v for k, v in cfg.to_json().items() if k not in MAY_CHANGE_ON_RESUME and not (k in later and v in later[k])
     }
     return json.loads(json.dumps(kept))
 

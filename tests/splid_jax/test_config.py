@@ -246,3 +246,20 @@ def test_an_old_config_json_loads_and_resumes_as_it_ran(tmp_path):
     for name, value in (("select_radius", 0.8), ("relabel", "settle"), ("held_share", 0.1)):
         with pytest.raises(InvalidConfig, match=name):
             TrainConfig.from_json({**OLD_CONFIG, name: value})
+
+
+def test_a_her_run_recorded_before_mrls_defaults_reads_its_options_against_baselines_and_resumes():
+    from splid_jax.learners.her.config import BASELINES
+    from splid_jax.runtime.run_files import identity
+
+    new = TrainConfig(env="push", algo="her", her_options="hidden=16,16,batch_size=32")
+    old = {k: v for k, v in new.to_json().items() if k != "her_defaults"}  # config.json before the setting
+    resumed = TrainConfig.from_json(old)
+    her = resumed.learner_config()
+    assert (her.hidden, her.batch_size) == ((16, 16), 32)  # the keys it gave
+    assert all(getattr(her, k) == v for k, v in BASELINES.items() if k not in ("hidden", "batch_size"))
+    # the checkpoint's identity as that run wrote it: its options as written, no her_defaults
+    assert identity(resumed) == {k: v for k, v in identity(new).items() if k != "her_defaults"}
+    assert identity(resumed)["her_options"] == "hidden=16,16,batch_size=32"
+    assert TrainConfig.from_json(new.to_json()).learner_config() == new.learner_config()  # today's: mrl's defaults
+    assert new.learner_config().layer_norm and not her.layer_norm

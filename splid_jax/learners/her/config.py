@@ -113,3 +113,6 @@ BASELINES = dict(
     warm_up=0,
 )
 BASELINES_WORKERS = 8
+# What a run's HER options are read against (its her_defaults): HerConfig's own, or Baselines' for runs recorded
+# while those were HER's defaults.
+DEFAULTS = {"mrl": {}, "baselines": BASELINES}
