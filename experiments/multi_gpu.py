@@ -161,15 +161,16 @@ def figure(r: Runner, a: argparse.Namespace, scratch: str) -> dict:
         say(f"CUDA MPS control daemon started: {started}")
         time.sleep(1)
     out["mps"] = bool(mps)
+    where = a.figure_out or scratch
     try:
 
         def build(gpus):
             return [sys.executable, "-m", "splid_jax.figures", "fig3", "--env", a.figure_env, "--episodes",
                     str(a.figure_episodes), "--side-by-side", "--set", "checkpoint_every=0", "--compile-cache", "",
-                    "--out", os.path.join(scratch, f"fig3-{gpus}"), "--quiet", *a.figure_args.split()]  # fmt: skip
+                    "--out", os.path.join(where, f"fig3-{gpus}"), "--quiet", *a.figure_args.split()]  # fmt: skip
 
         for side, done in r.sides("figure 3", build, a).items():
-            fig = os.path.join(scratch, f"fig3-{side}")
+            fig = os.path.join(where, f"fig3-{side}")
             try:
                 record = json.load(open(os.path.join(fig, "figure.json")))
                 per = {}
@@ -184,7 +185,8 @@ def figure(r: Runner, a: argparse.Namespace, scratch: str) -> dict:
             except (OSError, json.JSONDecodeError, KeyError):
                 per = {}
             out[side] = {"rc": done["rc"], "wall_s": done["wall_s"], "processes": per}
-            shutil.rmtree(fig, ignore_errors=True)
+            if not a.figure_out:
+                shutil.rmtree(fig, ignore_errors=True)
     finally:
         if started:
             subprocess.run([mps], input="quit\n", text=True, capture_output=True)
@@ -281,6 +283,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--figure-env", default="push")
     p.add_argument("--figure-episodes", type=int, default=1000, help="Figure 3's budget per method (default 1,000)")
     p.add_argument("--figure-args", default="", help="more figures flags, space-separated (e.g. --quick --seeds 2)")
+    p.add_argument("--figure-out", default=None, help="keep the figures in DIR/fig3-1, DIR/fig3-N (default: removed)")
     p.add_argument("--single-env", default="pick_and_place")
     p.add_argument("--single-envs", type=int, default=4096)
     p.add_argument("--single-iterations", type=int, default=4)

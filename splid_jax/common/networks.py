@@ -29,14 +29,18 @@ class MLP(nn.Module):
     activation: str = "leaky_relu"  # a flax.linen activation: "leaky_relu" or "relu"
     tanh_output: bool = False
     layer_norm: bool = False  # LayerNorm between each hidden layer and its activation (mrl's DDPG nets)
+    # The hidden layers' computation dtype ("bfloat16": mixed precision, their products on bf16 tensor cores);
+    # the parameters and the output layer stay float32, so values and targets keep their resolution.
+    dtype: str | None = None
 
     @nn.compact
     def __call__(self, x: jax.Array) -> jax.Array:
         act = getattr(nn, self.activation)
         for width in self.hidden:
-            x = nn.Dense(width, kernel_init=nn.initializers.orthogonal(jnp.sqrt(2.0)))(x)
-            x = act(nn.LayerNorm()(x) if self.layer_norm else x)
-        x = nn.Dense(self.action_size, kernel_init=nn.initializers.orthogonal(0.01))(x)
+            x = nn.Dense(width, kernel_init=nn.initializers.orthogonal(jnp.sqrt(2.0)), dtype=self.dtype)(x)
+            x = act(nn.LayerNorm(dtype=self.dtype)(x) if self.layer_norm else x)
+        out_dtype = None if self.dtype is None else jnp.float32
+        x = nn.Dense(self.action_size, kernel_init=nn.initializers.orthogonal(0.01), dtype=out_dtype)(x)
         return jnp.tanh(x) if self.tanh_output else x
 
 

@@ -52,6 +52,11 @@ class HerConfig:
         "precision of the gradient steps' matrix products on a GPU: float32, tensorfloat32 or bfloat16 "
         "(jax.default_matmul_precision; the physics and the acting policy stay float32)",
     )
+    compute_dtype: str = field(
+        "float32",
+        "dtype of the actor's and critic's hidden layers: float32, or bfloat16 for mixed precision on a GPU's "
+        "tensor cores (parameters, optimiser, normaliser, output layers and TD targets stay float32)",
+    )
     norm_eps: float = field(0.01, "std floor of the observation and goal normaliser")
     clip_obs: float = field(200.0, "observations and goals are clipped to +-clip_obs before normalising")
 
@@ -65,6 +70,8 @@ class HerConfig:
         check(
             self.matmul_precision in precisions, "her.matmul_precision", self.matmul_precision, " or ".join(precisions)
         )
+        dtypes = ("float32", "bfloat16")
+        check(self.compute_dtype in dtypes, "her.compute_dtype", self.compute_dtype, " or ".join(dtypes))
         check(0 <= self.gamma < 1, "her.gamma", self.gamma, "in [0, 1)")
         check(len(self.hidden) >= 1 and min(self.hidden) >= 1, "her.hidden", self.hidden, "one or more widths >= 1")
         check(self.actor_lr > 0, "her.actor_lr", self.actor_lr, "> 0")

@@ -71,6 +71,8 @@ class HER(Chunked):
         self.capacity = her.buffer_transitions // T
         self.n_updates = her.updates_per_iteration(cfg.num_envs * T)
         nets = dict(hidden=her.hidden, activation="relu", layer_norm=her.layer_norm)
+        if her.compute_dtype != "float32":
+            nets["dtype"] = her.compute_dtype
         self.policy = Policy(
             net=MLP(**nets, action_size=env.action_size, tanh_output=True),
             in_size=env.obs_size + env.goal_size,

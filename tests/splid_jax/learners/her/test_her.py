@@ -238,6 +238,25 @@ def test_layer_norm_in_both_networks_where_configured():
         assert len(norms(state.policy.params)) + len(norms(state.critic)) == count
 
 
+def test_bfloat16_computes_the_hidden_layers_in_bfloat16_and_keeps_parameters_and_outputs_float32():
+    def dtypes(her):
+        state = her.init(jax.random.PRNGKey(0))
+        x = jnp.ones((2, state.critic["params"]["Dense_0"]["kernel"].shape[0]))
+        mlp = her.critic.clone(parent=None)
+        _, seen = mlp.apply(state.critic, x, capture_intermediates=True)
+        inner = [v[0].dtype for k, v in jax.tree_util.tree_flatten_with_path(seen)[0] if "Dense_0" in str(k)]
+        out = mlp.apply(state.critic, x)
+        params = {leaf.dtype for leaf in jax.tree_util.tree_leaves((state.critic, state.policy.params))}
+        return inner, out.dtype, params
+
+    inner, out, params = dtypes(_her(compute_dtype="bfloat16", hidden=(8, 8), buffer_transitions=500))
+    assert inner == [jnp.bfloat16] and out == jnp.float32 and params == {jnp.dtype(jnp.float32)}
+    inner, out, _ = dtypes(_her(hidden=(8, 8), buffer_transitions=500))
+    assert inner == [jnp.float32] and out == jnp.float32
+    with pytest.raises(InvalidConfig, match="compute_dtype"):
+        HerConfig(compute_dtype="float16")
+
+
 def test_targets_move_every_target_every_steps_only_once_warm():
     her = _her(
         update_every=0, n_batches=10, target_every=5, warm_up=0, hidden=(8,), batch_size=8, buffer_transitions=500
