@@ -48,9 +48,9 @@ class HerConfig:
     random_transitions: int = field(10_000, "the first this many collected transitions take uniformly random actions")
     warm_up: int = field(5_000, "no gradient step until the buffer holds this many transitions")
     matmul_precision: str = field(
-        "float32",
-        "precision of the gradient steps' matrix products on a GPU: float32, tensorfloat32 or bfloat16 "
-        "(jax.default_matmul_precision; the physics and the acting policy stay float32)",
+        "default",
+        "precision of the gradient steps' float32 matrix products on a GPU: default (JAX's: TensorFloat-32 on "
+        "NVIDIA GPUs since Ampere), float32, tensorfloat32 or bfloat16 (jax.default_matmul_precision)",
     )
     compute_dtype: str = field(
         "float32",
@@ -66,7 +66,7 @@ class HerConfig:
             check(getattr(self, name) >= 0, f"her.{name}", getattr(self, name), "an integer >= 0")
         for name in ("random_transitions", "warm_up"):
             check(getattr(self, name) >= 0, f"her.{name}", getattr(self, name), "an integer >= 0")
-        precisions = ("float32", "tensorfloat32", "bfloat16")
+        precisions = ("default", "float32", "tensorfloat32", "bfloat16")
         check(
             self.matmul_precision in precisions, "her.matmul_precision", self.matmul_precision, " or ".join(precisions)
         )

@@ -237,6 +237,8 @@ class HER(Chunked):
         batches are drawn at once. Where the targets stay fixed over them (``target_every`` 0, Baselines),
         so do their TD targets, computed in one pass before the steps; otherwise each step computes its own
         and the targets move every ``target_every`` steps."""
+        if self.her.matmul_precision == "default":
+            return self._updates(hs, key)
         with jax.default_matmul_precision(self.her.matmul_precision):
             return self._updates(hs, key)
 
