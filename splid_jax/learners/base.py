@@ -12,6 +12,7 @@ import jax
 import jax.numpy as jnp
 
 from envs.base import GoalEnv
+from splid_jax.common import ticks
 from splid_jax.common.evaluation import evaluate
 from splid_jax.common.subgoals import steered
 
@@ -86,9 +87,13 @@ class Chunked:
     def trained(self, state: Any, hyper: Any) -> tuple[Any, tuple]:
         """The chunk's training, a program of its own: the host loop compiles it and ``report`` side by
         side, as XLA optimises one program on one thread. Returns the state and what ``report`` reads."""
-        state, per_iteration = jax.lax.scan(
-            lambda s, _: self.iteration(s, hyper), state, None, length=self.cfg.eval_every
-        )
+
+        def one(s, _):
+            s, metrics = self.iteration(s, hyper)
+            ticks.tick(ticks.ITERATION, lambda: s.iteration, after=metrics)  # the iteration's last values
+            return s, metrics
+
+        state, per_iteration = jax.lax.scan(one, state, None, length=self.cfg.eval_every)
         key, k_eval = jax.random.split(state.key)
         return state.replace(key=key), (per_iteration, k_eval)
 

@@ -95,11 +95,12 @@ def run(
     resume: bool = False,
     quiet: bool = False,
     on_record: Callable[[str, dict], None] | None = None,
+    inside_every: float = 10.0,
 ) -> list[dict]:
     """Train to ``cfg.iterations``; returns the last metrics record of each lane (one for a run).
 
-    ``on_record(run_dir, record)`` sees every record as it is written to its lane's metrics.jsonl
-    (a TensorBoard writer, say).
+    ``on_record(run_dir, record)`` sees every record as it is written to its lane's metrics.jsonl (a TensorBoard
+    writer, say). On one CPU with the display on, what a chunk did is shown every ``inside_every`` s (``Watch``).
 
     ``members``: the configs of a sweep's members (each its own seed, run_dir and traced settings),
     trained in lock-step as one vmapped program with checkpoints under ``cfg.run_dir``. Over several
@@ -109,23 +110,22 @@ def run(
         place = placement(cfg, None if members is None else len(members), algo)
         split_envs = place.axis == devices.ENVS and place.count > 1
         algo = algo or signals.wait(lambda: registry.make_algorithm(cfg, env, place.mesh if split_envs else None))
-        return _Loop(cfg, env, algo, members, place, signals, quiet, on_record).run(resume)
+        return _Loop(cfg, env, algo, members, place, signals, quiet, on_record, inside_every).run(resume)
 
 
 class _Loop:
     def __init__(self, cfg, env, algo, members, place: devices.Placement, signals: Signals, quiet: bool,
-                 on_record: Callable[[str, dict], None] | None = None):  # fmt: skip
-        self.cfg, self.env, self.algo, self.signals = cfg, env, algo, signals
-        self.on_record = on_record
+                 on_record: Callable[[str, dict], None] | None = None, inside_every: float = 10.0):  # fmt: skip
+        self.cfg, self.env, self.algo, self.signals, self.on_record = cfg, env, algo, signals, on_record
         self.writes = multihost.is_first()  # the others compute their share and leave the run directory alone
         self.quiet = quiet or not self.writes
-        self.stacked = members is not None
-        self.lanes = list(members) if self.stacked else [cfg]
-        self.place = place
-        self.device = place.first
+        self.stacked, self.lanes = members is not None, [cfg] if members is None else list(members)
+        self.place, self.device = place, place.first
         self.saved_at: int | None = None
         self.groups: Groups | None = None
         self.writing: Callable[[], None] | None = None  # a checkpoint write running beside the next chunk
+        alone = not self.quiet and not self.stacked and place.count == 1 and self.device.platform == "cpu"
+        self.watch = progress.Watch(self.show, cfg.eval_every, algo.counters, inside_every) if alone else None
 
     def show(self, text: str) -> None:
         progress.show(text, self.quiet)
@@ -198,7 +198,7 @@ class _Loop:
         t0 = time.perf_counter()
         try:
             traced = self.signals.wait(
-                lambda: programs.trace(fns, one, groups.first(hyper_one) if groups else hyper_one)
+                lambda: programs.trace(fns, one, groups.first(hyper_one) if groups else hyper_one, self.watch)
             )
         except OverflowError as e:  # an index past int32: sizes far beyond any device's memory
             raise DoesNotFit(
@@ -215,8 +215,8 @@ class _Loop:
         on = f"{place.count} devices{processes} split by {place.axis}" if place.count > 1 else self.device.platform
         self.show(f"splid_jax: algo={algo.name} env={cfg.env} device={on}"
                   + (f" members={len(self.lanes)}" if self.stacked else ""))  # fmt: skip
-        self.show(f"compiling the training program ({compile_hint(self.env)}; "
-                  "less when the compile cache holds it)...")  # fmt: skip
+        cached = "less when the compile cache holds it" if self.watch is None else progress.NOT_CACHED
+        self.show(f"compiling the training program ({compile_hint(self.env)}; {cached})...")
         building = self.signals.begin(made)  # beside the compile: beside the trace it slowed the trace
         t0 = time.perf_counter()
         pending = []
@@ -331,11 +331,12 @@ class _Loop:
         try:
             while iteration < cfg.iterations:
                 t0 = time.perf_counter()
-                new_state, metrics = self.signals.wait(
-                    lambda s=state: jax.block_until_ready(compiled(s, hyper)),
-                    late_after(slowest),
-                    lambda ran, i=iteration, was=slowest: self.warn_late(i, ran, was),
-                )
+                with self.watch.chunk(iteration) if self.watch else contextlib.nullcontext():
+                    new_state, metrics = self.signals.wait(
+                        lambda s=state: jax.block_until_ready(compiled(s, hyper)),
+                        late_after(slowest),
+                        lambda ran, i=iteration, was=slowest: self.warn_late(i, ran, was),
+                    )
                 chunk_s = time.perf_counter() - t0
                 slowest = max(slowest, chunk_s)
                 metrics = jax.device_get(metrics)

@@ -8,11 +8,13 @@ about the time of the larger, not of both."""
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Callable
 from typing import Any
 
 import jax
 
+from splid_jax.common import ticks
 from splid_jax.runtime.memory import largest_value
 from splid_jax.runtime.signals import Signals
 
@@ -25,10 +27,13 @@ def parts(algo, stacked: bool) -> list[Callable]:
     return [jax.vmap(f) for f in fns] if stacked else fns
 
 
-def trace(fns: list[Callable], state_like, hyper_like) -> list[jax.stages.Traced]:
+def trace(fns: list[Callable], state_like, hyper_like, watch: ticks.Watcher | None = None) -> list[jax.stages.Traced]:
     """Each part traced on abstract arguments; the report's state is the training's (the same shapes
-    and placement), the rest of its input the training's second output, placed as the state."""
-    first = jax.jit(fns[0]).trace(state_like, hyper_like)
+    and placement), the rest of its input the training's second output, placed as the state. With
+    ``watch``, the training carries the learner's progress ticks (``common.ticks``), traced anew."""
+    train = fns[0] if watch is None else functools.wraps(fns[0])(lambda *a: fns[0](*a))  # no cached trace reused
+    with ticks.watching(watch):
+        first = jax.jit(train).trace(state_like, hyper_like)
     if len(fns) == 1:
         return [first]
     sharding = jax.tree.leaves(state_like)[0].sharding

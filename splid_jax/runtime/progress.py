@@ -1,4 +1,5 @@
-"""One terminal line per chunk (per sweep chunk: one summary line), from the metrics.jsonl record."""
+"""One terminal line per chunk (per sweep chunk: one summary line), from the metrics.jsonl record; on a
+CPU, lines from inside a chunk too (``Watch``)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,14 @@ import contextlib
 import json
 import os
 import sys
+import threading
+import time
+from collections.abc import Callable, Iterator
+
+from splid_jax.common.ticks import EXPLORED, ITERATION
+
+# A program with the chunk's ticks (``common.ticks``) is one JAX keeps out of its compile cache.
+NOT_CACHED = "not kept in the compile cache while the display shows progress inside a chunk: --quiet keeps it"
 
 
 def _si(x: float) -> str:
@@ -73,6 +82,81 @@ def quiet_stdout() -> None:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         os.close(devnull)
+
+
+class Watch:
+    """What the chunk under way has done (``common.ticks``' watcher), shown as one line at most every
+    ``interval`` seconds, from a timer of its own where no tick comes (0: a line at every tick, no timer).
+    Ticks arrive on XLA's thread; those of a chunk no longer waited for (a signal) are not shown."""
+
+    def __init__(self, show: Callable[[str], None], iterations: int, counters: Callable[[int, int], dict],
+                 interval: float = 10.0, clock: Callable[[], float] = time.monotonic):  # fmt: skip
+        """``iterations``: a chunk's; ``counters``: the learner's (``learners.base.Algorithm.counters``)."""
+        self.show, self.iterations, self.counters = show, iterations, counters
+        self.interval, self.clock = interval, clock
+        self.lock = threading.RLock()
+        self.running = False
+        self.begin(0)
+
+    def begin(self, iteration: int) -> None:
+        """A chunk starts after ``iteration`` completed iterations."""
+        with self.lock:
+            self.first, self.done, self.explored, self.rounds, self.left = iteration, iteration, False, 0, None
+            self.started = self.shown = self.clock()
+
+    def seen(self, stage: str, value) -> None:
+        with self.lock:
+            if stage == ITERATION:
+                self.done, self.explored, self.rounds, self.left = int(value), False, 0, None
+            elif stage == EXPLORED:
+                self.done, self.explored, self.rounds, self.left = int(value), True, 0, None
+            else:
+                self.rounds, self.left = self.rounds + 1, int(value)
+            self.show_if_due()
+
+    def line(self) -> str:
+        with self.lock:
+            n = self.done - self.first + 1  # the iteration under way, counted in the chunk
+            if n > self.iterations:
+                doing = f"{self.iterations} iterations trained, evaluating"
+            elif not self.explored:
+                doing = f"iteration {n}/{self.iterations} of the chunk: exploring"
+            else:
+                doing = f"iteration {n}/{self.iterations} of the chunk: explored"
+                if self.left is not None:
+                    doing += f", SELECT round {self.rounds} ({self.left:,} verdicts left)"
+            episodes = self.counters(self.done + self.explored, 0)["episodes"]
+            return f"  ... {doing}; {episodes:,} episodes explored, {self.clock() - self.started:.0f} s into the chunk"
+
+    def show_if_due(self) -> None:
+        with self.lock:  # one line at a time, from either thread
+            now = self.clock()
+            if self.running and now - self.shown >= self.interval:
+                self.shown = now
+                self.show(self.line())
+
+    @contextlib.contextmanager
+    def chunk(self, iteration: int) -> Iterator[None]:
+        """While the chunk from ``iteration`` is waited for."""
+        self.begin(iteration)
+        stop = threading.Event()
+
+        def timer():
+            while not stop.wait(self.interval):
+                self.show_if_due()
+
+        thread = threading.Thread(target=timer, name="splid_jax-progress", daemon=True)
+        self.running = True
+        if self.interval > 0:
+            thread.start()
+        try:
+            yield
+        finally:
+            with self.lock:
+                self.running = False
+            stop.set()
+            if thread.is_alive():
+                thread.join()
 
 
 def read_metrics(path: str, error: type[Exception]) -> list[dict]:

@@ -21,6 +21,7 @@ import jax
 import jax.numpy as jnp
 
 from envs.base import GoalEnv, State, step_batch
+from splid_jax.common import ticks
 from splid_jax.common.networks import Policy, PolicyState
 from splid_jax.learners.imitation.candidates import Candidates
 from splid_jax.learners.imitation.explore import Trajectory
@@ -91,7 +92,7 @@ def replay_queue(
         jnp.int32(0),
     )
 
-    def body(q: _Queue) -> _Queue:
+    def one_round(q: _Queue) -> _Queue:
         s = step_batch(env, q.state, policy.act(pstate, q.state.obs, q.state.desired_goal))
         steps = q.steps + 1
         hit = env.success(s.achieved_goal, s.desired_goal) & ~s.invalid
@@ -110,6 +111,11 @@ def replay_queue(
             reached=reached,
             replay_steps=q.replay_steps + jnp.sum(q.active, dtype=jnp.int32),
         )
+
+    def body(q: _Queue) -> _Queue:
+        q = one_round(q)
+        ticks.tick(ticks.ROUND, lambda: count - q.next + jnp.sum(q.active, dtype=jnp.int32))  # verdicts left
+        return q
 
     q = jax.lax.while_loop(lambda q: jnp.any(q.active), body, q)
     return q.reached[:m], q.replay_steps

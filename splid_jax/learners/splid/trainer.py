@@ -11,6 +11,7 @@ from jax.sharding import Mesh
 from jax.sharding import PartitionSpec as P
 
 from envs.base import GoalEnv
+from splid_jax.common import ticks
 from splid_jax.common.errors import check
 from splid_jax.common.networks import PolicyState, make_policy
 from splid_jax.common.subgoals import traced_reach
@@ -145,7 +146,9 @@ class Trainer(Chunked):
             noise = hold_fingers(noise, hyper.gripper_hold)
         horizon = self.horizon_at(ts.iteration, hyper)
         sigma = self.sigma_at(ts.iteration, hyper)
-        seen, cands = self.explore_and_select(ts.policy, reset_keys, noise, sigma, horizon, hyper.explore_reach)
+        seen, cands = self.explore_and_select(
+            ts.policy, reset_keys, noise, sigma, horizon, hyper.explore_reach, ts.iteration
+        )
         if self.learner.clones_every_pair:
             cands = gcsl.relabel(env, seen, bc.gcsl_relabel, k_relabel)
         buf = relabel_buffer.insert(ts.buffer, cands.obs, cands.goal, cands.action, cands.accept)
@@ -169,11 +172,14 @@ class Trainer(Chunked):
         )
         return new, metrics
 
-    def explore_and_select(self, pstate, reset_keys, noise, sigma, horizon, reach) -> tuple[Seen, Candidates | None]:
+    def explore_and_select(
+        self, pstate, reset_keys, noise, sigma, horizon, reach, iteration=None
+    ) -> tuple[Seen, Candidates | None]:
         """Explore the envs and, but for GCSL, SELECT among their relabelled pairs: all of them, or,
-        inside the mesh's ``shard_map``, this device's slice, gathered back in the one-device layout."""
+        inside the mesh's ``shard_map``, this device's slice, gathered back in the one-device layout.
+        ``iteration`` (completed iterations) goes to the progress ticks."""
         if self.mesh is None:
-            return self._explore_and_select(pstate, reset_keys, noise, sigma, horizon, reach)
+            return self._explore_and_select(pstate, reset_keys, noise, sigma, horizon, reach, iteration)
         (axis,) = self.mesh.axis_names
         n = self.cfg.num_envs // self.mesh.size
         first = jax.lax.axis_index(axis) * n
@@ -193,8 +199,12 @@ class Trainer(Chunked):
         whole = [gather(x.reshape((-1, n) + x.shape[1:])).reshape((-1,) + x.shape[1:]) for x in cands[:-1]]
         return seen, Candidates(*whole, jax.lax.psum(cands.replay_steps, axis))
 
-    def _explore_and_select(self, pstate, reset_keys, noise, sigma, horizon, reach) -> tuple[Seen, Candidates | None]:
+    def _explore_and_select(
+        self, pstate, reset_keys, noise, sigma, horizon, reach, iteration=None
+    ) -> tuple[Seen, Candidates | None]:
         traj = rollout(self.env, self.policy, pstate, reset_keys, noise, sigma, reach)
+        if iteration is not None:
+            ticks.tick(ticks.EXPLORED, lambda: iteration, after=traj.actions[-1, 0, 0])
         if self.learner.clones_every_pair:
             return traj.seen(), None
         return traj.seen(), self.select(pstate, traj, horizon)
