@@ -265,7 +265,9 @@ def add_compile_cache_flag(parser: argparse.ArgumentParser) -> None:
         metavar="DIR",
         default=default_compile_cache(),
         help="keep compiled programs in DIR, so a rerun with the same task and shapes skips most of "
-        "its compilation ('' turns it off; default: %(default)s)",
+        "its compilation ('' turns it off; default: %(default)s). On a CPU, one run with its progress display on "
+        "compiles its training program anew each time, as JAX keeps no program that calls back to the host for "
+        "the lines inside a chunk: --quiet keeps it",
     )
 
 

@@ -120,7 +120,7 @@ class Watch:
             if n > self.iterations:
                 doing = f"{self.iterations} iterations trained, evaluating"
             elif not self.explored:
-                doing = f"iteration {n}/{self.iterations} of the chunk: exploring"
+                doing = f"iteration {n}/{self.iterations} of the chunk: started"
             else:
                 doing = f"iteration {n}/{self.iterations} of the chunk: explored"
                 if self.left is not None:

@@ -85,7 +85,7 @@ def test_a_watch_shows_a_line_where_no_tick_comes():
         assert shown == []
         clock.now = 12.0  # a long exploration: the timer's line says so
         assert line.wait(30)
-    assert shown == ["  ... iteration 2/3 of the chunk: exploring; 4 episodes explored, 12 s into the chunk"]
+    assert shown == ["  ... iteration 2/3 of the chunk: started; 4 episodes explored, 12 s into the chunk"]
 
 
 def test_only_a_watched_trace_carries_the_ticks():
