@@ -1,6 +1,7 @@
 """The progress display: a closed stdout (``| head``) silences it and the run goes on to its end; on a CPU,
 lines from inside a chunk (what it explored, SELECT's rounds), which change nothing the run computes."""
 
+import dataclasses
 import os
 import re
 import sys
@@ -10,6 +11,7 @@ import jax
 import jax.numpy as jnp
 import pytest
 
+import envs
 from splid_jax import train
 from splid_jax.common import ticks
 from splid_jax.common.ticks import EXPLORED, ITERATION, ROUND
@@ -97,6 +99,48 @@ def test_only_a_watched_trace_carries_the_ticks():
     watch = Watch(lambda text: None, 1, counters)
     quiet, watched = (programs.trace([train], like, like, w)[0].jaxpr for w in (None, watch))
     assert "callback" not in str(quiet) and "callback" in str(watched)
+
+
+@dataclasses.dataclass
+class Ticking:
+    """An ``learners.base.Algorithm`` that compiles in a moment and ticks at each iteration, as learners do."""
+
+    env: object
+    cfg: TrainConfig
+    name = "ticking"
+
+    def init(self, key):
+        return {"w": jnp.zeros(()), "key": key, "iteration": jnp.int32(0)}
+
+    def hyper(self, cfg=None):
+        return {}
+
+    def chunk(self, state, hyper):
+        def one(s, _):
+            s = {**s, "w": s["w"] + 1.0, "iteration": s["iteration"] + 1}
+            ticks.tick(ITERATION, lambda: s["iteration"], after=s["w"])
+            return s, None
+
+        s, _ = jax.lax.scan(one, state, None, length=self.cfg.eval_every)
+        metrics = {key: s["w"] for key in ("eval_success", "eval_success_final", "eval_return")}
+        return s, {**metrics, "finite": jnp.isfinite(s["w"])}
+
+    def counters(self, iteration, select_steps):
+        return {"iteration": iteration, "episodes": iteration * 4, "env_steps": iteration * 200, "select_steps": 0}
+
+
+def test_only_a_single_run_with_its_display_on_shows_lines_inside_its_chunks(tmp_path, capsys):
+    cfg = TrainConfig(env="point", num_envs=4, eval_every=2, iterations=4, eval_episodes=4, run_dir=str(tmp_path / "a"))
+    env = envs.make("point")
+    loop.run(cfg, env, algo=Ticking(env, cfg), inside_every=0)
+    inside = [text for text in capsys.readouterr().out.splitlines() if text.startswith("  ... ")]
+    assert [text[: text.index(";")] for text in inside] == 2 * [
+        "  ... iteration 2/2 of the chunk: started", "  ... 2 iterations trained, evaluating"
+    ], inside  # fmt: skip
+    lanes = [dataclasses.replace(cfg, seed=s, run_dir=os.path.join(cfg.run_dir, f"s{s}")) for s in (0, 1)]
+    sweep = dataclasses.replace(cfg, run_dir=str(tmp_path / "sweep"))
+    loop.run(sweep, env, algo=Ticking(env, sweep), members=lanes, inside_every=0)  # a sweep: one line per chunk
+    assert "  ... " not in capsys.readouterr().out  # (a quiet run shows nothing: the next test)
 
 
 # SMALL's settings, 5 iterations: one chunk, whose evaluation program the three runs of this file share
