@@ -1,10 +1,10 @@
 """The one host loop: trains any ``learners.base.Algorithm``, one run or a vmapped set of sweep members.
 
-Python runs only between compiled chunks: it logs, writes metrics.jsonl (one schema for every
-algorithm, run and sweep), evaluates through the chunk, checkpoints with orbax, stops on NaN, and
-resumes bit for bit. The state's size is checked against the device's memory before anything is
-built, and the chunk's intermediates once it is traced; the chunk is compiled once, a learner's
-training and report as two programs side by side (``programs``), timed apart from the first chunk.
+Python runs between compiled chunks (on a CPU with the display on, also at the ticks inside one, to show them:
+``progress.Watch``): it logs, writes metrics.jsonl (one schema for every algorithm, run and sweep), evaluates through
+the chunk, checkpoints with orbax, stops on NaN, and resumes bit for bit. The state's size is checked against the
+device's memory before anything is built, and the chunk's intermediates once it is traced; the chunk is compiled once,
+a learner's training and report as two programs side by side (``programs``), timed apart from the first chunk.
 While XLA compiles, the keys, the settings and the initial state are built on the device in a thread
 (built beside the trace, they slowed it), and on one process each checkpoint is written while the next chunk
 runs, so neither waits on the other (experiments/NOTES.md, "The host loop's overlaps").
