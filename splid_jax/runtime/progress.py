@@ -141,8 +141,8 @@ class Watch:
         self.begin(iteration)
         stop = threading.Event()
 
-        def timer():
-            while not stop.wait(self.interval):
+        def timer():  # wakes when the next line is due, however the last one came
+            while not stop.wait(max(0.0, self.shown + self.interval - self.clock())):
                 self.show_if_due()
 
         thread = threading.Thread(target=timer, name="splid_jax-progress", daemon=True)
