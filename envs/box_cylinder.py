@@ -1,0 +1,170 @@
+"""Box-cylinder contacts for MJX, which has none: up to four contacts per pair, as MJX's collision functions return
+them (dist [4], pos [4, 3], frame [4, 3, 3]; an unused contact has dist 1, which no margin reaches).
+
+Why: the reference's Fetch fingers are boxes and FetchSlide's puck a cylinder; MuJoCo C collides them (its general
+convex collider, one normal per pair and up to four points on the shapes' touching features), MJX does not. This
+module does the same in closed form, so a Slide can strike and press the puck with the reference's finger pads
+(``tests/envs/test_box_cylinder.py`` checks it against MuJoCo C).
+
+How: in the cylinder's frame, the normal is the separating-axis candidate of least penetration among the cap's
+axis, the box's three axes, the horizontal directions from the cylinder's axis to the box's corners and to the
+points of its edges nearest that axis, and the directions from the rim to each corner. For a box whose axes include
+the cylinder's (the fingers on an upright puck, at any yaw) that set holds the exact minimum; for a tilted box it is
+an approximation whose normal errs by about the tilt where an edge crosses the rim. The contact points then follow
+the feature of the cylinder that the normal selects: on a cap, the corners of the box's face that faces it, clipped
+to the disc along the face's edges, each at its own depth; on the side wall, the wall's vertical segment clipped
+to the box's extent along it (two points); on the rim, the rim point (one).
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+NCON = 4
+UNUSED = 1.0  # dist of a contact slot that holds no contact
+_CAP, _SIDE = 1e-5, 1e-5  # |n_z| above 1 - _CAP: a cap's normal; below _SIDE: the side wall's
+_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], np.float64)  # corners
+_EDGES = np.array([(i, j) for i in range(8) for j in range(i + 1, 8) if np.abs(_SIGNS[i] - _SIGNS[j]).sum() == 2])
+# each face (axis, side) as its four corners in cyclic order
+_FACES = np.zeros((3, 2, 4), np.int32)
+for _a in range(3):
+    _b, _c = (_a + 1) % 3, (_a + 2) % 3
+    for _side, _s in enumerate((-1, 1)):
+        for _k, (_u, _v) in enumerate(((-1, -1), (1, -1), (1, 1), (-1, 1))):
+            _corner = np.zeros(3)
+            _corner[[_a, _b, _c]] = (_s, _u, _v)
+            _FACES[_a, _side, _k] = int(np.flatnonzero((_SIGNS == _corner).all(axis=1))[0])
+
+
+def _unit(v, fallback):
+    n = jnp.linalg.norm(v, axis=-1, keepdims=True)
+    return jnp.where(n > 1e-12, v / jnp.where(n > 1e-12, n, 1.0), fallback)
+
+
+def _flat(v):
+    """Horizontal unit directions of ``v`` [..., 3] (x axis where ``v`` is vertical)."""
+    h = v * jnp.array([1.0, 1.0, 0.0])
+    return _unit(h, jnp.array([1.0, 0.0, 0.0]))
+
+
+def _separation(n, center, axes, size, radius, half):
+    """Signed separation along unit normals ``n`` [k, 3] (from the cylinder to the box) of the box (centre, axes as
+    columns, half sizes) from the cylinder (radius, half height), in the cylinder's frame."""
+    box_low = n @ center - jnp.abs(n @ axes) @ size
+    cyl_high = half * jnp.abs(n[:, 2]) + radius * jnp.linalg.norm(n[:, :2], axis=-1)
+    return box_low - cyl_high
+
+
+def _edge_nearest_axis(corners):
+    """The point of each box edge [12, 3] whose horizontal distance to the cylinder's axis is least."""
+    a, b = corners[_EDGES[:, 0]], corners[_EDGES[:, 1]]
+    d = (b - a)[:, :2]
+    dd = jnp.sum(d * d, axis=-1)
+    t = jnp.clip(-jnp.sum(a[:, :2] * d, axis=-1) / jnp.where(dd > 1e-12, dd, 1.0), 0.0, 1.0)
+    return a + t[:, None] * (b - a)
+
+
+def _candidates(center, axes, corners, radius, half):
+    """Candidate normals [k, 3]: the cap's axis, the box's axes, horizontal directions to corners and edges,
+    and rim-to-corner directions; each pointing from the cylinder towards the box."""
+    cap = jnp.array([[0.0, 0.0, 1.0]]) * jnp.where(center[2] >= 0, 1.0, -1.0)
+    box = axes.T * jnp.where(axes.T @ center >= 0, 1.0, -1.0)[:, None]
+    radial = _flat(jnp.concatenate([center[None], corners, _edge_nearest_axis(corners)]))
+    rim = jnp.concatenate([_flat(corners)[:, :2] * radius, half * jnp.where(corners[:, 2:] >= 0, 1.0, -1.0)], axis=1)
+    to_corner = _unit(corners - rim, radial[1:9])
+    return jnp.concatenate([cap, box, radial, to_corner])
+
+
+def _clip_to_disc(face, radius):
+    """The face's corners [4, 3] (cyclic) moved onto the disc of ``radius`` (in xy) along an edge where outside:
+    toward the next corner, else the previous; with whether each lies on the disc."""
+
+    def entry(p, q):  # the first t in [0, 1] where p + t (q - p) meets the circle, from outside
+        d = (q - p)[:2]
+        a, b, c = jnp.dot(d, d), 2.0 * jnp.dot(p[:2], d), jnp.dot(p[:2], p[:2]) - radius**2
+        disc = b * b - 4.0 * a * c
+        t = (-b - jnp.sqrt(jnp.maximum(disc, 0.0))) / (2.0 * jnp.where(a > 1e-12, a, 1.0))
+        ok = (disc >= 0.0) & (a > 1e-12) & (t >= 0.0) & (t <= 1.0)
+        return p + t * (q - p), ok
+
+    nxt, prv = jnp.roll(face, -1, axis=0), jnp.roll(face, 1, axis=0)
+    pn, okn = jax.vmap(entry)(face, nxt)
+    pp, okp = jax.vmap(entry)(face, prv)
+    inside = jnp.sum(face[:, :2] ** 2, axis=-1) <= radius**2
+    moved = jnp.where(okn[:, None], pn, pp)
+    pts = jnp.where(inside[:, None], face, moved)
+    return pts, inside | okn | okp
+
+
+def _make_frame(n):
+    """MJX's ``math.make_frame``: rows normal, tangent, bitangent."""
+    from mujoco.mjx._src import math as mjx_math
+
+    return mjx_math.make_frame(n)
+
+
+def box_cylinder(cyl_pos, cyl_mat, cyl_size, box_pos, box_mat, box_size):
+    """(dist [4], pos [4, 3], frame [4, 3, 3]) of a cylinder (geom 1: pos [3], mat [3, 3], size: radius, half
+    height) against a box (geom 2: pos, mat, half sizes): normals point from the cylinder to the box, a contact's
+    position is midway between the surfaces and its dist negative in penetration, as in MJX and MuJoCo C."""
+    radius, half = cyl_size[0], cyl_size[1]
+    center = cyl_mat.T @ (box_pos - cyl_pos)
+    axes = cyl_mat.T @ box_mat  # the box's axes as columns, in the cylinder's frame
+    corners = center + (jnp.asarray(_SIGNS, center.dtype) * box_size) @ axes.T
+    normals = _candidates(center, axes, corners, radius, half)
+    seps = _separation(normals, center, axes, box_size, radius, half)
+    best = jnp.argmax(seps)
+    n, sep = normals[best], seps[best]
+    # the box's face that faces the cylinder along n
+    along = axes.T @ n
+    face_axis = jnp.argmax(jnp.abs(along))
+    side = jnp.where(along[face_axis] > 0, 0, 1)  # the face whose outward normal opposes n
+    face = corners[jnp.asarray(_FACES)[face_axis, side]]
+    # on a cap: the face's corners clipped to the disc, each at its own depth
+    cap_sign = jnp.where(n[2] >= 0, 1.0, -1.0)
+    on_disc, cap_ok = _clip_to_disc(face, radius)
+    cap_dist = cap_sign * on_disc[:, 2] - half
+    cap_pos = on_disc - jnp.array([0.0, 0.0, 1.0]) * cap_sign * 0.5 * cap_dist[:, None]
+    # on the side wall: its vertical segment clipped to the box's z extent along the wall
+    u = _flat(n[None])[0]
+    depth = corners @ n
+    deep = depth <= jnp.min(depth) + 1e-6 * (1.0 + jnp.max(box_size))  # the box's feature facing the wall
+    z_lo = jnp.maximum(-half, jnp.min(jnp.where(deep, corners[:, 2], jnp.inf)))
+    z_hi = jnp.minimum(half, jnp.max(jnp.where(deep, corners[:, 2], -jnp.inf)))
+    wall = jnp.stack([radius * u + jnp.array([0.0, 0.0, 1.0]) * z for z in (z_lo, z_hi)])
+    side_pos = jnp.concatenate([wall, wall]) + 0.5 * sep * n
+    side_ok = jnp.array([True, False, False, False]) | (jnp.arange(4) == 1) & (z_hi - z_lo > 1e-6)
+    # on the rim: the rim point
+    rim = radius * u + jnp.array([0.0, 0.0, 1.0]) * half * cap_sign
+    rim_pos = jnp.broadcast_to(rim + 0.5 * sep * n, (NCON, 3))
+    rim_ok = jnp.arange(4) == 0
+    is_cap = jnp.abs(n[2]) > 1.0 - _CAP
+    is_side = jnp.abs(n[2]) < _SIDE
+    pos = jnp.where(is_cap, cap_pos, jnp.where(is_side, side_pos, rim_pos))
+    ok = jnp.where(is_cap, cap_ok, jnp.where(is_side, side_ok, rim_ok))
+    dist = jnp.where(is_cap, cap_dist, sep)
+    dist = jnp.where(ok, dist, UNUSED)
+    world_n = cyl_mat @ n
+    world_pos = cyl_pos + pos @ cyl_mat.T
+    return dist, world_pos, jnp.broadcast_to(_make_frame(world_n), (NCON, 3, 3))
+
+
+def box_cylinder_group(m, d, key, geom):
+    """The collision driver's function for the (cylinder, box) group: every pair's four contacts, pairs in
+    order (geom 1 the cylinder, as MJX orders a pair by geom type)."""
+    g1, g2 = geom.T
+    dist, pos, frame = jax.vmap(box_cylinder)(d.geom_xpos[g1], d.geom_xmat[g1], m.geom_size[g1, :2],
+                                              d.geom_xpos[g2], d.geom_xmat[g2], m.geom_size[g2])  # fmt: skip
+    return dist.reshape(-1), pos.reshape(-1, 3), frame.reshape(-1, 3, 3)
+
+
+box_cylinder_group.ncon = NCON
+
+
+def groups() -> dict:
+    """{(CYLINDER, BOX): the driver's function} as ``envs/mjx_patch.py`` puts it in MJX's table."""
+    from mujoco.mjx._src.types import GeomType
+
+    return {(GeomType.CYLINDER, GeomType.BOX): box_cylinder_group}

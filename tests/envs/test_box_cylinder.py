@@ -1,0 +1,119 @@
+"""The box-cylinder contact against MuJoCo C's on fixed configurations of a reference finger pad and Slide's puck.
+
+Tolerances: depths 2e-5 m (float32 arithmetic on centimetre geoms), normals 0.01 and points 0.5 mm where MuJoCo
+C's convex collider finds the same feature (it meets the disc's edge on a polygon, up to 0.4 mm inside the circle);
+where its normal and ours are a near tie (a slightly tilted box, whose face and the cap both fit) normals within
+0.06 and depths per point. Where a box's vertical edge presses the side wall, MuJoCo C's normal is the box's face
+normal and its depth 0.2 mm shallower than the exact least penetration; there ours is checked against the exact
+minimum over 20,000 sampled directions instead.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import jax
+import jax.numpy as jnp
+import mujoco
+import numpy as np
+import pytest
+
+from envs.box_cylinder import _separation, box_cylinder
+
+PAD = (0.0135, 0.007, 0.0385)  # a reference finger pad's half sizes
+PUCK = (0.025, 0.02)
+MARGIN = 0.001
+
+
+def _mujoco(box_pos, box_euler=(0, 0, 0), cyl_euler=(0, 0, 0)):
+    """MuJoCo C's contacts (dist, pos, normal) and the geoms' poses, for the pad at ``box_pos`` near the puck."""
+    xml = f"""<mujoco><compiler angle="radian"/><option gravity="0 0 0"/><worldbody>
+      <body euler="{' '.join(map(str, cyl_euler))}"><freejoint/>
+        <geom name="puck" type="cylinder" size="{PUCK[0]} {PUCK[1]}" contype="0" conaffinity="0"/></body>
+      <body pos="{' '.join(map(str, box_pos))}" euler="{' '.join(map(str, box_euler))}"><freejoint/>
+        <geom name="pad" type="box" size="{' '.join(map(str, PAD))}" contype="0" conaffinity="0"/></body>
+    </worldbody><contact><pair geom1="pad" geom2="puck" margin="{MARGIN}" condim="4"/></contact></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    c = d.contact[: d.ncon]
+    poses = [(d.geom_xpos[g].copy(), d.geom_xmat[g].reshape(3, 3).copy(), m.geom_size[g].copy()) for g in (0, 1)]
+    return (np.array([x.dist for x in c]), np.array([x.pos for x in c]).reshape(-1, 3),
+            np.array([x.frame[:3] for x in c]).reshape(-1, 3), poses)  # fmt: skip
+
+
+@functools.cache
+def _ours():
+    return jax.jit(box_cylinder)
+
+
+def _contacts(poses):
+    (cp, cm, cs), (bp, bm, bs) = poses
+    dist, pos, frame = _ours()(*(jnp.asarray(x, jnp.float32) for x in (cp, cm, cs[:2], bp, bm, bs)))
+    live = np.asarray(dist) < MARGIN
+    return np.asarray(dist)[live], np.asarray(pos)[live], np.asarray(frame)[live, 0]
+
+
+def _matched(points, others, tol):
+    """Whether every point has one of ``others`` within ``tol`` (m)."""
+    return all(np.min(np.linalg.norm(others - p, axis=1)) < tol for p in points)
+
+
+SAME_FEATURE = {  # (box position, box euler): MuJoCo C and ours meet the same features
+    "above the top face": ((0.0, 0.0, 0.0565), (0, 0, 0)),
+    "pressing the rim": ((-0.02, 0.0, 0.0555), (0, 0, 0)),
+    "overhanging the rim": ((-0.03, 0.0, 0.0575), (0, 0, 0)),
+    "touching the side": ((0.037, 0.0, 0.0), (0, 0, 0)),
+    "corner on the edge": ((0.02, 0.02, 0.055), (0, 0, 0.5)),
+}
+
+
+@pytest.mark.parametrize("name", SAME_FEATURE)
+def test_same_contacts_as_mujoco_c(name):
+    box_pos, euler = SAME_FEATURE[name]
+    c_dist, c_pos, c_normal, poses = _mujoco(box_pos, euler)
+    dist, pos, normal = _contacts(poses)
+    assert len(c_dist) >= 2 and len(dist) >= len(c_dist) - 1, (c_dist, dist)
+    np.testing.assert_allclose(np.sort(dist), np.sort(c_dist)[: len(dist)] if len(dist) < len(c_dist) else
+                               np.sort(c_dist), atol=2e-5)  # fmt: skip
+    np.testing.assert_allclose(normal, np.broadcast_to(c_normal[0], normal.shape), atol=0.01)
+    assert _matched(pos, c_pos, 5e-4) and _matched(c_pos[: len(pos)], pos, 5e-4), (pos, c_pos)
+
+
+def test_tilted_box_on_the_top_face():
+    c_dist, c_pos, c_normal, poses = _mujoco((0.0, 0.0, 0.058), (0.05, 0.03, 0.0))
+    dist, pos, normal = _contacts(poses)
+    assert len(dist) == len(c_dist) == 4
+    order = [int(np.argmin(np.linalg.norm(c_pos - p, axis=1))) for p in pos]
+    np.testing.assert_allclose(dist, c_dist[order], atol=2e-5)
+    np.testing.assert_allclose(pos, c_pos[order], atol=5e-4)
+    assert np.all(normal @ c_normal[0] > np.cos(0.06))
+
+
+def test_tilted_puck_under_a_level_box():
+    c_dist, c_pos, c_normal, poses = _mujoco((0.0, 0.0, 0.0575), cyl_euler=(0.1, 0, 0))
+    dist, pos, normal = _contacts(poses)
+    assert np.min(dist) == pytest.approx(np.min(c_dist), abs=2e-5)
+    np.testing.assert_allclose(normal[np.argmin(dist)], c_normal[np.argmin(c_dist)], atol=0.01)
+    # MuJoCo C puts one point midway along the deepest edge; ours its two ends
+    deep = pos[np.abs(dist - np.min(dist)) < 1e-5]
+    assert len(deep) == 2 and np.linalg.norm(deep.mean(axis=0) - c_pos[np.argmin(c_dist)]) < 1e-3
+
+
+def test_edge_against_the_side_is_the_least_penetration():
+    c_dist, c_pos, _, poses = _mujoco((0.036, 0.01, 0.03), (0, 0, 0.7))
+    dist, pos, normal = _contacts(poses)
+    assert len(dist) == len(c_dist) == 2 and _matched(pos, c_pos, 5e-4)
+    (cp, cm, _), (bp, bm, bs) = poses
+    dirs = np.random.default_rng(0).normal(size=(20000, 3))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    seps = np.asarray(_separation(jnp.asarray(dirs), jnp.asarray(cm.T @ (bp - cp)), jnp.asarray(cm.T @ bm),
+                                  jnp.asarray(bs), PUCK[0], PUCK[1]))  # fmt: skip
+    assert np.min(dist) == pytest.approx(seps.max(), abs=1e-4) and np.min(dist) >= seps.max() - 1e-6
+    assert normal[0] @ (cm @ dirs[np.argmax(seps)]) > np.cos(0.1)
+
+
+def test_apart_no_contact():
+    c_dist, _, _, poses = _mujoco((0.0, 0.0, 0.06))  # 1.5 mm above the top face, beyond the margin
+    dist, _, _ = _contacts(poses)
+    assert len(c_dist) == 0 and len(dist) == 0
