@@ -168,3 +168,13 @@ def groups() -> dict:
     from mujoco.mjx._src.types import GeomType
 
     return {(GeomType.CYLINDER, GeomType.BOX): box_cylinder_group}
+
+
+def groups_for(m) -> dict:
+    """``groups()`` where model ``m`` (MjModel) has a cylinder-box pair to collide, else {}."""
+    import mujoco
+
+    cyl, box = int(mujoco.mjtGeom.mjGEOM_CYLINDER), int(mujoco.mjtGeom.mjGEOM_BOX)
+    types = {frozenset((int(m.geom_type[m.pair_geom1[i]]), int(m.geom_type[m.pair_geom2[i]]))) for i in range(m.npair)}
+    # geoms that collide by contype and conaffinity would also need it; the Fetch models collide by pairs only
+    return groups() if frozenset((cyl, box)) in types else {}

@@ -10,7 +10,8 @@ What may be replaced, each by its module's function (``None`` or ``False`` leave
 - ``jax.lax.while_loop``, for the loops of MJX's solver module only, and the solver's scan-based line search:
   ``envs/solver_loops.py``'s written-out loops;
 - ``mujoco.mjx._src.solver.solve``: ``envs/fused_solver.py``'s solve;
-- entries of ``mujoco.mjx._src.collision_driver._COLLISION_FUNC``: ``envs/fused_collision.py``'s pair groups.
+- entries of ``mujoco.mjx._src.collision_driver._COLLISION_FUNC``: ``envs/fused_collision.py``'s pair groups, and
+  ``envs/box_cylinder.py``'s, a pair MJX lacks: added within the block, removed again on the way out.
 """
 
 from __future__ import annotations
@@ -44,7 +45,7 @@ def patched_mjx(
     with TRACE_LOCK:
         table = collision_driver._COLLISION_FUNC
         saved = (jsl.cho_factor, jsl.cho_solve, jax.lax.while_loop, mjx_solver._while_loop_scan, mjx_solver.solve)
-        saved_groups = {key: table[key] for key in collide or {}}
+        saved_groups = {key: table.get(key) for key in collide or {}}
         try:
             if cholesky:
                 jsl.cho_factor, jsl.cho_solve = cholesky
@@ -58,4 +59,8 @@ def patched_mjx(
             yield
         finally:
             jsl.cho_factor, jsl.cho_solve, jax.lax.while_loop, mjx_solver._while_loop_scan, mjx_solver.solve = saved
-            table.update(saved_groups)
+            for key, group in saved_groups.items():
+                if group is None:
+                    del table[key]
+                else:
+                    table[key] = group

@@ -20,8 +20,9 @@ Every geom is a primitive with ``contype = conaffinity = 0``; the only collision
   (``table="box"`` gives the box). An object pushed past an edge glides on instead of falling; every
   goal lies on or above the table, so such an episode fails on both.
 - Slide: the reference's cylinder puck (radius 0.025, half-height 0.02, mass 2, friction 0.1 on the
-  table). MJX collides a cylinder with a sphere but not with a box, so the closed fingers strike it
-  with four round corner tips. The gripper weighs 13 kg, the reference arm's effective mass at the
+  table). Stock MJX collides a cylinder with a sphere but not with a box, so by default the closed fingers
+  strike it with four round corner tips; ``finger="pads"`` gives the reference's two box pads, collided by
+  ``envs/box_cylinder.py`` (``slide_fingers``). The gripper weighs 13 kg, the reference arm's effective mass at the
   grip site; lighter, it launches the puck too slowly.
 - ``finger="pads"`` (Push's default): the block has the horizontal extent of the reference's two closed
   finger pads at the cube's height (``PADS_HALF_XY``), so a push moves the cube as far as there;
@@ -38,6 +39,7 @@ import functools
 import mujoco
 import numpy as np
 
+from envs.fetch import slide_fingers
 from envs.fetch.control import ARM_REACH_CENTER, ARM_REACH_CENTER_DEFAULT
 
 TABLE_TOP = 0.4
@@ -73,9 +75,7 @@ REFERENCE_FINGER_DAMPING = 1000.0
 # Slide only (see the module docstring): the reference arm's effective mass at the grip site, the
 # fingertip corners that strike the puck, and their contact with it.
 SLIDE_GRIPPER_MASS = 13.0
-SLIDE_TIP_XY = 0.0155  # fingertip corner centres at (+-, +-) this from the grip site: scripted.FINGER_HALF_XY
-SLIDE_TIP_RADIUS = 0.004
-SLIDE_TIP_FRICTION = "1 1 0.05 0.01 0.01"  # the reference finger-puck pair: friction 1, torsional 0.05, condim 4
+SLIDE_TIP_XY, SLIDE_TIP_RADIUS = slide_fingers.TIP_XY, slide_fingers.TIP_RADIUS
 
 # kind -> (table centre xyz, table half-size xyz, initial grip-site position). The start positions
 # are those the reference's episodes begin from (read off its resets in experiments/parity): Push
@@ -118,8 +118,9 @@ def tables_for(kind: str) -> tuple[str, ...]:
 def fingers_for(kind: str) -> tuple[str, ...]:
     """Collision shapes of the closed finger block: Push may use the reference pads' extent
     (``PADS_HALF_XY``), a smaller box, or a vertical capsule of the box's height (radius 1.1 cm); Slide
-    strikes with round tips, PickAndPlace grips with two box fingers, Reach touches nothing."""
-    return ("pads", "box", "capsule") if kind == "push" else ("box",)
+    strikes with round tips or the reference's two pads (``slide_fingers``), PickAndPlace grips with two box
+    fingers, Reach touches nothing."""
+    return ("pads", "box", "capsule") if kind == "push" else slide_fingers.FINGERS if kind == "slide" else ("box",)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -256,26 +257,9 @@ def mjcf(
     <pair geom1="finger_l" geom2="object" condim="4" friction="1 1 0.005 0.0001 0.0001"/>
     <pair geom1="finger_r" geom2="object" condim="4" friction="1 1 0.005 0.0001 0.0001"/>"""
     elif slide:
-        # Closed fingers drawn as a block; they strike the puck with four round corner tips. With a finger-table
-        # contact the block and the tips reach the reference's fingertips' depth, the tips' bottoms level with
-        # the block's (without it, the tips' centres sit at the grip site, where they were fitted to the strike).
-        c, r = SLIDE_TIP_XY, SLIDE_TIP_RADIUS
-        tips = [(f"tip_{i}", sx * c, sy * c) for i, (sx, sy) in enumerate([(1, 1), (1, -1), (-1, 1), (-1, -1)])]
-        block_z, tip_z = (finger_z, r - below) if finger_table > 0 else (finger_z + r, 0.0)
-        fingers = f"""
-      <geom name="fingers" type="box" size="{_fmt(c, c)} 0.03" pos="0 0 {block_z:.6g}" mass="0.001"
-            {nograv} rgba="0.3 0.3 0.3 1"/>""" + "".join(
-            f"""
-      <geom name="{n}" type="sphere" size="{r:.6g}" pos="{_fmt(x, y, tip_z)}" mass="0.001" {nograv}
-            rgba="0.3 0.3 0.3 1"/>"""
-            for n, x, y in tips
-        )
+        fingers, finger_pairs, table_fingers = slide_fingers.mjcf(finger, below, finger_table,
+                                                                  f'{nograv} rgba="0.3 0.3 0.3 1"')  # fmt: skip
         finger_act = ""
-        finger_pairs = "".join(
-            f"""
-    <pair geom1="{n}" geom2="object" condim="4" friction="{SLIDE_TIP_FRICTION}"/>"""
-            for n, _, _ in tips
-        )
     else:
         shape = {
             "capsule": 'type="capsule" size="0.011 0.019"',
@@ -312,7 +296,7 @@ def mjcf(
     <pair geom1="object" geom2="floor" condim="3"/>"""
 
     if finger_table > 0:
-        names = ("finger_l", "finger_r") if free_fingers else ("fingers",)
+        names = ("finger_l", "finger_r") if free_fingers else table_fingers if slide else ("fingers",)
         finger_pairs += "".join(
             f"""
     <pair geom1="{n}" geom2="table" condim="3" friction="{finger_table:.6g} {finger_table:.6g} 0.005 0.0001 0.0001"/>"""
@@ -355,6 +339,21 @@ def rest_height(m: mujoco.MjModel, object_q: int) -> float:
     return float(d.qpos[object_q + 2])
 
 
+def own_contacts(m: mujoco.MjModel):
+    """The block within which MJX knows the contacts model ``m`` needs and it lacks (box-cylinder:
+    ``envs/box_cylinder.py``); put_model, make_data and a step's trace of ``m`` must run inside it."""
+    import contextlib
+
+    from envs import box_cylinder
+
+    groups = box_cylinder.groups_for(m)
+    if not groups:
+        return contextlib.nullcontext()
+    from envs import mjx_patch
+
+    return mjx_patch.patched_mjx(collide=groups)
+
+
 @functools.cache
 def build(kind: str, **options):
     """``(mj_model, mjx_model, layout)`` for task ``kind`` with ``mjcf``'s keyword ``options``; cached,
@@ -388,6 +387,6 @@ def build(kind: str, **options):
         nv=int(m.nv),
         nu=int(m.nu),
     )
-    with jax.ensure_compile_time_eval():  # first use may come from inside a jit trace
+    with jax.ensure_compile_time_eval(), own_contacts(m):  # first use may come from inside a jit trace
         mx = mjx.put_model(m, impl="jax")
     return m, mx, layout

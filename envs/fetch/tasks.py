@@ -31,7 +31,6 @@ dense Cholesky solves unrolled, and on a GPU the solve and box contacts as Palla
 from __future__ import annotations
 
 import dataclasses
-import functools
 
 import jax
 import jax.numpy as jnp
@@ -39,7 +38,7 @@ import jax.numpy as jnp
 from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
 from envs.fetch import control, kernels, models, observation
 from envs.fetch.observation import Physics
-from envs.physics import BACKENDS, in_use
+from envs.physics import BACKENDS, KERNELS_CHECKED, in_use, kernels_checked
 from envs.settings import check, check_integer
 
 MIN_OBJECT_DISTANCE = 0.1  # the object starts at least this far from the gripper in xy
@@ -73,7 +72,8 @@ class _FetchTask(GoalEnv):
     # Parity-study options (experimental): the reference's variants of parts of the physics.
     # the table's collision shape: its top face as a plane, or the reference's box
     table: str = experimental("plane")
-    # the closed finger block's collision shape (Push: pads, box or capsule, see models.py)
+    # the closed finger block's collision shape (Push: pads, box or capsule, see models.py; Slide: the round tips
+    # (box) or the reference's two box pads (pads), see envs/fetch/slide_fingers.py)
     finger: str = experimental("box")
     # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     cholesky: str = experimental("unrolled")
@@ -132,6 +132,9 @@ class _FetchTask(GoalEnv):
         check(self.table in tables, f"{n}.table", self.table, "one of " + ", ".join(tables))
         fingers = models.fingers_for(n)
         check(self.finger in fingers, f"{n}.finger", self.finger, "one of " + ", ".join(fingers))
+        own = n == "slide" and self.finger == "pads"  # a contact MJX lacks, on the MuJoCo it was checked on
+        ok = not own or kernels_checked()
+        check(ok, f"{n}.finger", self.finger, f"box on this MuJoCo (pads' contact was checked on {KERNELS_CHECKED})")
         spaces = control.WORKSPACES
         check(self.workspace in spaces, f"{n}.workspace", self.workspace, "one of " + ", ".join(spaces))
         check(self.drive in models.DRIVES, f"{n}.drive", self.drive, "one of " + ", ".join(models.DRIVES))
@@ -274,13 +277,17 @@ class _FetchTask(GoalEnv):
         from mujoco import mjx
 
         model = self.mjx_model
-        data = mjx.make_data(model)
-        if self.drive == "weld":  # the constraint pulls the gripper to the mocap body, put at the target
-            home = jnp.asarray(self.layout.grip_home, data.mocap_pos.dtype)
-            data = data.replace(mocap_pos=data.mocap_pos.at[0].set(home + ctrl[0:3]))
-        step = functools.partial(mjx_substeps, model, data, phys.replace(ctrl=ctrl), self.substeps)
+
+        def step():
+            data = mjx.make_data(model)
+            if self.drive == "weld":  # the constraint pulls the gripper to the mocap body, put at the target
+                home = jnp.asarray(self.layout.grip_home, data.mocap_pos.dtype)
+                data = data.replace(mocap_pos=data.mocap_pos.at[0].set(home + ctrl[0:3]))
+            return mjx_substeps(model, data, phys.replace(ctrl=ctrl), self.substeps)
+
         if self.physics_in_use() != "kernels":
-            return step()
+            with models.own_contacts(self.mj_model):
+                return step()
         with kernels.mjx_with_kernels(self):
             return step()
 
