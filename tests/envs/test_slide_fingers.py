@@ -1,0 +1,62 @@
+"""Slide's finger options: the reference's box pads collide with the puck in MJX through the box-cylinder contact,
+registered only while MJX builds and steps such a model, and the scripted strike succeeds with them."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+from mujoco.mjx._src import collision_driver
+from mujoco.mjx._src.types import GeomType
+
+import envs
+from envs.fetch import models, slide_fingers
+
+PADS = {"finger": "pads", "finger_table": 1.0}
+
+
+def test_pads_are_the_reference_pads_with_its_contact():
+    m = models.build("slide", finger="pads", finger_table=1.0)[0]
+    for name, center in zip(("pad_r", "pad_l"), slide_fingers.PAD_CENTERS, strict=True):
+        g = m.geom(name)
+        assert g.type[0] == mujoco.mjtGeom.mjGEOM_BOX
+        np.testing.assert_allclose(g.size, slide_fingers.PAD_HALF)
+        np.testing.assert_allclose(g.pos, center)
+    puck = m.geom("object").id
+    pairs = [i for i in range(m.npair) if puck in (m.pair_geom1[i], m.pair_geom2[i])
+             and m.geom_type[m.pair_geom1[i] + m.pair_geom2[i] - puck] == mujoco.mjtGeom.mjGEOM_BOX]  # fmt: skip
+    assert len(pairs) == 2
+    for i in pairs:
+        assert m.pair_dim[i] == 4 and m.pair_margin[i] == pytest.approx(0.001)
+        np.testing.assert_allclose(m.pair_solref[i], (0.015, 1.0))
+        np.testing.assert_allclose(m.pair_friction[i], (1, 1, 0.05, 0.01, 0.01))
+    # the pads touch the table (finger_table) through MJX's own plane-box contact
+    table = m.geom("table").id
+    assert sum(table in (m.pair_geom1[i], m.pair_geom2[i]) for i in range(m.npair)) == 3
+
+
+def test_the_box_cylinder_entry_lives_only_while_mjx_uses_it():
+    models.build("slide", finger="pads", finger_table=1.0)  # put_model ran with the entry
+    assert (GeomType.CYLINDER, GeomType.BOX) not in collision_driver._COLLISION_FUNC
+    with pytest.raises(NotImplementedError):  # stock MJX has no such pair
+        from mujoco import mjx
+
+        mjx.put_model(models.build("slide", finger="pads", finger_table=1.0)[0])
+
+
+def test_round_tips_stay_the_default():
+    assert envs.make("slide").finger == "box"
+    m = models.build("slide")[0]
+    names = {m.geom(i).name for i in range(m.ngeom)}
+    assert {"tip_0", "tip_3"} <= names and not {"pad_r", "pad_l"} & names
+
+
+@pytest.mark.slow
+def test_scripted_strike_succeeds_with_the_reference_pads(fetch):
+    env = envs.make("slide", **PADS)
+    s0, _, traj = fetch.run(env, np.zeros((fetch.T, fetch.B, 4)), w=1.0)
+    assert not bool(traj.invalid.any())
+    reached = np.asarray(traj.success).any(axis=0)
+    assert reached.mean() >= 0.75, reached
+    obs = np.asarray(traj.obs)
+    assert np.abs(obs[..., 3:5] - np.asarray(s0.obs)[None, :, 3:5]).max() > 0.1  # the pucks were struck
