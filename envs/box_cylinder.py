@@ -10,8 +10,10 @@ How: in the cylinder's frame, the normal is the separating-axis candidate of lea
 axis, the box's three axes, the horizontal directions from the cylinder's axis to the box's corners and to the
 points of its edges nearest that axis, and the directions from the rim to each corner. For a box whose axes include
 the cylinder's (the fingers on an upright puck, at any yaw) that set holds the exact minimum; for a tilted box it is
-an approximation whose normal errs by about the tilt where an edge crosses the rim. The contact points then follow
-the feature of the cylinder that the normal selects: on a cap, the corners of the box's face that faces it, clipped
+an approximation whose normal errs by about the tilt where an edge crosses the rim. A normal within ``SNAP`` of the
+axis selects the cap, within ``SNAP`` of horizontal the side wall, so a box face on a slightly tilted puck (or float
+rounding in its tilt) keeps a face contact rather than a point. The contact points then follow the feature of the
+cylinder that the normal selects: on a cap, the corners of the box's face that faces it, clipped
 to the disc along the face's edges, each at its own depth; on the side wall, the wall's vertical segment clipped
 to the box's extent along it (two points); on the rim, the rim point (one).
 """
@@ -24,7 +26,7 @@ import numpy as np
 
 NCON = 4
 UNUSED = 1.0  # dist of a contact slot that holds no contact
-_CAP, _SIDE = 1e-5, 1e-5  # |n_z| above 1 - _CAP: a cap's normal; below _SIDE: the side wall's
+SNAP = 0.1  # rad: a normal this close to the cylinder's axis is the cap's, this close to horizontal the wall's
 _SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], np.float64)  # corners
 _EDGES = np.array([(i, j) for i in range(8) for j in range(i + 1, 8) if np.abs(_SIGNS[i] - _SIGNS[j]).sum() == 2])
 # each face (axis, side) as its four corners in cyclic order
@@ -117,6 +119,11 @@ def box_cylinder(cyl_pos, cyl_mat, cyl_size, box_pos, box_mat, box_size):
     seps = _separation(normals, center, axes, box_size, radius, half)
     best = jnp.argmax(seps)
     n, sep = normals[best], seps[best]
+    # within SNAP of the axis the cap faces the box, within SNAP of horizontal the side wall: a box face resting on a
+    # slightly tilted puck keeps its four points (MuJoCo C's multi-point contact does too)
+    is_cap = jnp.abs(n[2]) >= np.cos(SNAP)
+    is_side = jnp.abs(n[2]) <= np.sin(SNAP)
+    u = _flat(n[None])[0]
     # the box's face that faces the cylinder along n
     along = axes.T @ n
     face_axis = jnp.argmax(jnp.abs(along))
@@ -127,10 +134,9 @@ def box_cylinder(cyl_pos, cyl_mat, cyl_size, box_pos, box_mat, box_size):
     on_disc, cap_ok = _clip_to_disc(face, radius)
     cap_dist = cap_sign * on_disc[:, 2] - half
     cap_pos = on_disc - jnp.array([0.0, 0.0, 1.0]) * cap_sign * 0.5 * cap_dist[:, None]
-    # on the side wall: its vertical segment clipped to the box's z extent along the wall
-    u = _flat(n[None])[0]
+    # on the side wall: its vertical segment (at the normal's horizontal direction u) clipped to the box's z extent
     depth = corners @ n
-    deep = depth <= jnp.min(depth) + 1e-6 * (1.0 + jnp.max(box_size))  # the box's feature facing the wall
+    deep = depth <= jnp.min(depth) + 2.0 * SNAP * jnp.max(box_size)  # the box's feature facing the wall
     z_lo = jnp.maximum(-half, jnp.min(jnp.where(deep, corners[:, 2], jnp.inf)))
     z_hi = jnp.minimum(half, jnp.max(jnp.where(deep, corners[:, 2], -jnp.inf)))
     wall = jnp.stack([radius * u + jnp.array([0.0, 0.0, 1.0]) * z for z in (z_lo, z_hi)])
@@ -140,12 +146,14 @@ def box_cylinder(cyl_pos, cyl_mat, cyl_size, box_pos, box_mat, box_size):
     rim = radius * u + jnp.array([0.0, 0.0, 1.0]) * half * cap_sign
     rim_pos = jnp.broadcast_to(rim + 0.5 * sep * n, (NCON, 3))
     rim_ok = jnp.arange(4) == 0
-    is_cap = jnp.abs(n[2]) > 1.0 - _CAP
-    is_side = jnp.abs(n[2]) < _SIDE
     pos = jnp.where(is_cap, cap_pos, jnp.where(is_side, side_pos, rim_pos))
     ok = jnp.where(is_cap, cap_ok, jnp.where(is_side, side_ok, rim_ok))
     dist = jnp.where(is_cap, cap_dist, sep)
     dist = jnp.where(ok, dist, UNUSED)
+    # a box face on a cap pushes along the face's normal, as MuJoCo C's face contacts mostly do: a pad pressed on a
+    # slightly tilted puck then presses it down, not sideways
+    face_n = axes[:, face_axis] * jnp.where(along[face_axis] > 0, 1.0, -1.0)
+    n = jnp.where(is_cap & (jnp.abs(face_n[2]) >= np.cos(SNAP)), face_n, n)
     world_n = cyl_mat @ n
     world_pos = cyl_pos + pos @ cyl_mat.T
     return dist, world_pos, jnp.broadcast_to(_make_frame(world_n), (NCON, 3, 3))

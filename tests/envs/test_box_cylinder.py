@@ -2,8 +2,9 @@
 
 Tolerances: depths 2e-5 m (float32 arithmetic on centimetre geoms), normals 0.01 and points 0.5 mm where MuJoCo
 C's convex collider finds the same feature (it meets the disc's edge on a polygon, up to 0.4 mm inside the circle);
-where its normal and ours are a near tie (a slightly tilted box, whose face and the cap both fit) normals within
-0.06 and depths per point. Where a box's vertical edge presses the side wall, MuJoCo C's normal is the box's face
+where the box's face rests on the cap within ``SNAP`` of parallel, ours pushes along the face's normal, as MuJoCo
+C's mostly does (its convex collider returns the cap's or the face's, by a small margin either way): normals within
+the tilt, depths per point. Where a box's vertical edge presses the side wall, MuJoCo C's normal is the box's face
 normal and its depth 0.2 mm shallower than the exact least penetration; there ours is checked against the exact
 minimum over 20,000 sampled directions instead.
 """
@@ -94,7 +95,9 @@ def test_tilted_puck_under_a_level_box():
     c_dist, c_pos, c_normal, poses = _mujoco((0.0, 0.0, 0.0575), cyl_euler=(0.1, 0, 0))
     dist, pos, normal = _contacts(poses)
     assert np.min(dist) == pytest.approx(np.min(c_dist), abs=2e-5)
-    np.testing.assert_allclose(normal[np.argmin(dist)], c_normal[np.argmin(c_dist)], atol=0.01)
+    # MuJoCo C's normal is the cap's here, the box face's at other tilts; ours is the face's: within the tilt
+    assert normal[0] @ c_normal[0] > np.cos(0.1 + 1e-3)
+    np.testing.assert_allclose(normal[0], poses[1][1][:, 2], atol=1e-6)
     # MuJoCo C puts one point midway along the deepest edge; ours its two ends
     deep = pos[np.abs(dist - np.min(dist)) < 1e-5]
     assert len(deep) == 2 and np.linalg.norm(deep.mean(axis=0) - c_pos[np.argmin(c_dist)]) < 1e-3
