@@ -51,11 +51,13 @@ class GoalEnv(abc.ABC):
     def settings(self) -> dict:
         """Every option of this task, defaults included, by name: what a checkpoint records so that a
         resume under changed task defaults is caught, not silently continued. An option that changes
-        only how the same arithmetic is computed (field metadata ``numerics_only``) is left out at its
+        only how the same arithmetic is computed (field metadata ``numerics_only``), or one added after
+        runs were recorded whose default is how they ran (``recorded_when_set``), is left out at its
         default, so runs recorded before it existed still match."""
+        later = ("numerics_only", "recorded_when_set")
         fields = [
             f for f in dataclasses.fields(self)
-            if not (f.metadata.get("numerics_only") and getattr(self, f.name) == f.default)
+            if not (any(f.metadata.get(k) for k in later) and getattr(self, f.name) == f.default)
         ]  # fmt: skip
         return {"task": type(self).__name__, **{f.name: getattr(self, f.name) for f in fields}}
 

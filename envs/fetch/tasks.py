@@ -106,6 +106,9 @@ class _FetchTask(GoalEnv):
     # the fingers are as long as the reference's and a gripper driven down at the table presses and drags.
     # Push: 1 (the reference's), the others 0.
     finger_table: float = experimental(0.0)
+    # The gripper's mass in kg (0: the task's, models.mjcf): how hard the weld drive presses (Slide's pads sink
+    # into the puck as deep as the reference's at 22 kg, its arm's effective mass along z at the grip site)
+    gripper_mass: float = experimental(0.0, recorded_when_set=True)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -145,6 +148,7 @@ class _FetchTask(GoalEnv):
         check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
         check(0 <= self.floor_clearance <= 0.1, f"{n}.floor_clearance", self.floor_clearance, "in [0, 0.1] m")
         check(0 <= self.finger_table <= 2, f"{n}.finger_table", self.finger_table, "in [0, 2]")
+        check(0 <= self.gripper_mass <= 100, f"{n}.gripper_mass", self.gripper_mass, "in [0, 100] kg (0: the task's)")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -174,6 +178,7 @@ class _FetchTask(GoalEnv):
             finger=str(self.finger),
             drive=str(self.drive),
             finger_table=float(self.finger_table),
+            **({"gripper_mass": float(self.gripper_mass)} if self.gripper_mass else {}),
         )
 
     @property

@@ -83,6 +83,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--env-options", default="", help="our task's fields, e.g. finger=pads,finger_table=1")
     p.add_argument("--no-reference", action="store_true", help="ours only")
+    p.add_argument("--offsets", default=",".join(map(str, OFFSETS)), help="comma-separated, m behind the centre")
     p.add_argument("--strike", type=int, default=0, metavar="N", help="also the scripted strike on N episodes")
     p.add_argument("--no-press", action="store_true", help="the strike only")
     p.add_argument("--out", default=None)
@@ -98,13 +99,13 @@ def main(argv=None) -> int:
     if not args.no_reference:
         import_reference()
     result = {"env_options": args.env_options, "offsets": {}}
-    for offset in () if args.no_press else OFFSETS:
+    for offset in () if args.no_press else [float(x) for x in args.offsets.split(",")]:
         row = {"ours": measures(probe.ours(env, offset))}
         if not args.no_reference:
             row["fetch"] = measures(probe.reference(env, offset))
         result["offsets"][str(offset)] = row
         for name, m in row.items():
-            print(f"offset {offset:.2f} {name:5s} " + " ".join(f"{k}={v}" for k, v in m.items()), flush=True)
+            print(f"offset {offset:.4f} {name:5s} " + " ".join(f"{k}={v}" for k, v in m.items()), flush=True)
     if args.strike:
         result["strike"] = strike(options, args.strike)
         for name, m in result["strike"].items():

@@ -136,6 +136,8 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("slide", "finger_table", 3.0),
         ("push", "finger_table", -1.0),
         ("pick_and_place", "finger_drive", "instant"),
+        ("slide", "finger", "capsule"),  # the round tips or the reference's pads
+        ("slide", "gripper_mass", -1.0),
     ],
 )
 def test_bad_overrides_fail_naming_the_field(name, field, value):

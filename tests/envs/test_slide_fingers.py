@@ -51,6 +51,12 @@ def test_round_tips_stay_the_default():
     assert {"tip_0", "tip_3"} <= names and not {"pad_r", "pad_l"} & names
 
 
+def test_gripper_mass_is_recorded_only_when_set():
+    assert "gripper_mass" not in envs.make("slide").settings()  # runs recorded before it still resume
+    assert envs.make("slide", gripper_mass=22.0).settings()["gripper_mass"] == 22.0
+    assert models.build("slide", gripper_mass=22.0)[0].body("gripper").mass[0] == pytest.approx(22.0, abs=0.01)
+
+
 @pytest.mark.slow
 def test_scripted_strike_succeeds_with_the_reference_pads(fetch):
     env = envs.make("slide", **PADS)
