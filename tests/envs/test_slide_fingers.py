@@ -12,7 +12,8 @@ from mujoco.mjx._src.types import GeomType
 import envs
 from envs.fetch import models, slide_fingers
 
-PADS = {"finger": "pads", "finger_table": 1.0}
+# the Slide whose press matches the reference's (experiments/reference/results/slide-pads.md)
+PADS = {"finger": "pads", "finger_table": 1.0, "drive": "weld", "gripper_mass": 22.0}
 
 
 def test_pads_are_the_reference_pads_with_its_contact():
@@ -63,6 +64,6 @@ def test_scripted_strike_succeeds_with_the_reference_pads(fetch):
     s0, _, traj = fetch.run(env, np.zeros((fetch.T, fetch.B, 4)), w=1.0)
     assert not bool(traj.invalid.any())
     reached = np.asarray(traj.success).any(axis=0)
-    assert reached.mean() >= 0.5, reached  # 0.72 of 32 episodes (the reference: 0.965), see the results file
+    assert reached.mean() >= 0.75, reached  # 0.906 of 64 episodes (the reference: 0.965), see the results file
     obs = np.asarray(traj.obs)
     assert np.abs(obs[..., 3:5] - np.asarray(s0.obs)[None, :, 3:5]).max() > 0.1  # the pucks were struck
