@@ -7,6 +7,10 @@
 - ``"pads"``: the reference's two finger pads, boxes of its size at its closed fingers' place about the grip site,
   with its finger-puck contact (condim 4, friction, margin, solref and solimp as MuJoCo mixes the two geoms'). MJX
   collides them with the puck through ``envs/box_cylinder.py``, which a step must register (``box_cylinder.groups``).
+  The reference's fingers also touch its table (``finger_table=1``), and its arm, pulled by a mocap weld, presses
+  them into the puck far harder than the PD drive: with ``drive=weld`` and ``gripper_mass=22`` (its arm's effective
+  mass along z at the grip site) they sink as deep as there and drag the puck as fast
+  (``experiments/reference/results/slide-pads.md``, which also says what still differs).
 """
 
 from __future__ import annotations
