@@ -3,8 +3,10 @@ them (dist [4], pos [4, 3], frame [4, 3, 3]; an unused contact has dist 1, which
 
 Why: the reference's Fetch fingers are boxes and FetchSlide's puck a cylinder; MuJoCo C collides them (its general
 convex collider, one normal per pair and up to four points on the shapes' touching features), MJX does not. This
-module does the same in closed form, so a Slide can strike and press the puck with the reference's finger pads
-(``tests/envs/test_box_cylinder.py`` checks it against MuJoCo C).
+module does the same in closed form, so a Slide can strike and press the puck with the reference's finger pads.
+MuJoCo C has two such colliders, which disagree here: on the cap this module gives its native collider's (the
+default) face contacts, at the side wall the exact penetration as libccd does, where the native one often returns a
+box face's normal (``tests/envs/test_box_cylinder.py`` checks both).
 
 How: in the cylinder's frame, the normal is the separating-axis candidate of least penetration among the cap's
 axis, the box's three axes, the horizontal directions from the cylinder's axis to the box's corners and to the
@@ -12,7 +14,8 @@ points of its edges nearest that axis, and the directions from the rim to each c
 the cylinder's (the fingers on an upright puck, at any yaw) that set holds the exact minimum; for a tilted box it is
 an approximation whose normal errs by about the tilt where an edge crosses the rim. A normal within ``SNAP`` of the
 axis selects the cap, within ``SNAP`` of horizontal the side wall, so a box face on a slightly tilted puck (or float
-rounding in its tilt) keeps a face contact rather than a point. The contact points then follow the feature of the
+rounding in its tilt) keeps a face contact rather than a point, pushing along the box face's normal. The contact
+points then follow the feature of the
 cylinder that the normal selects: on a cap, the corners of the box's face that faces it, clipped
 to the disc along the face's edges, each at its own depth; on the side wall, the wall's vertical segment clipped
 to the box's extent along it (two points); on the rim, the rim point (one).

@@ -14,6 +14,9 @@ beside the puck, not on it).
 (``experiments/parity/run_ours.py``), beside the reference's 200 recorded in
 ``experiments/parity/results/strike_reference.json``: success at any and at the final step, and where the puck
 ends along the start-to-goal line (``along``, past the goal > 0) and off it (``across``).
+
+``--libccd``: the reference collides its convex pairs (the pads and the puck) with libccd instead of MuJoCo's native
+collider, its default; the two disagree on these contacts (``experiments/reference/results/slide-pads.md``).
 """
 
 from __future__ import annotations
@@ -63,7 +66,7 @@ def strike_stats(episodes: list[dict]) -> dict:
     }
 
 
-def strike(options: dict, episodes: int) -> dict:
+def strike(options: dict, episodes: int, libccd: bool = False) -> dict:
     """The scripted strike in our task and the reference's recorded one, as ``strike_stats``."""
     import run_ours
 
@@ -74,9 +77,28 @@ def strike(options: dict, episodes: int) -> dict:
         d = goal - start
         n = float(np.linalg.norm(d))
         ours.append({**r, "along": float(disp @ d / n - n), "across": float(abs(disp[0] * d[1] - disp[1] * d[0]) / n)})
-    with open(REFERENCE_STRIKE) as fh:
-        reference = json.load(fh)["episodes"]
+    if libccd:  # the reference's strike run here, under the other collider
+        import run_reference
+        import slide_strike
+
+        make_env = run_reference.make_env
+        run_reference.make_env = lambda name: _with_libccd(make_env(name))
+        try:
+            reference = slide_strike.run_reference(200, 0)["episodes"]
+        finally:
+            run_reference.make_env = make_env
+    else:
+        with open(REFERENCE_STRIKE) as fh:
+            reference = json.load(fh)["episodes"]
     return {"ours": strike_stats(ours), "fetch": strike_stats(reference)}
+
+
+def _with_libccd(env):
+    """``env`` (a FetchSlide-v4) colliding convex pairs with libccd rather than MuJoCo's native collider."""
+    import mujoco
+
+    env.unwrapped.model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_NATIVECCD)
+    return env
 
 
 def main(argv=None) -> int:
@@ -86,6 +108,8 @@ def main(argv=None) -> int:
     p.add_argument("--offsets", default=",".join(map(str, OFFSETS)), help="comma-separated, m behind the centre")
     p.add_argument("--strike", type=int, default=0, metavar="N", help="also the scripted strike on N episodes")
     p.add_argument("--no-press", action="store_true", help="the strike only")
+    p.add_argument("--libccd", action="store_true",
+                   help="the reference under libccd, not MuJoCo's native convex collider (its strike then run here)")
     p.add_argument("--out", default=None)
     args = p.parse_args(argv)
     import slide_on_puck as probe
@@ -98,7 +122,11 @@ def main(argv=None) -> int:
     env = envs.make("slide", **options)
     if not args.no_reference:
         import_reference()
-    result = {"env_options": args.env_options, "offsets": {}}
+        if args.libccd:
+            make_reference = probe.make_reference
+            probe.make_reference = lambda task: _with_libccd(make_reference(task))
+    result = {"env_options": args.env_options, "reference_collider": "libccd" if args.libccd else "native",
+              "offsets": {}}
     for offset in () if args.no_press else [float(x) for x in args.offsets.split(",")]:
         row = {"ours": measures(probe.ours(env, offset))}
         if not args.no_reference:
@@ -107,7 +135,7 @@ def main(argv=None) -> int:
         for name, m in row.items():
             print(f"offset {offset:.4f} {name:5s} " + " ".join(f"{k}={v}" for k, v in m.items()), flush=True)
     if args.strike:
-        result["strike"] = strike(options, args.strike)
+        result["strike"] = strike(options, args.strike, args.libccd)
         for name, m in result["strike"].items():
             print(f"strike {name:5s} " + " ".join(f"{k}={v}" for k, v in m.items()), flush=True)
     if args.out:
