@@ -154,6 +154,29 @@ def step_batch(env: GoalEnv, state: State, action: jax.Array) -> State:
     return jax.tree.map(lambda x: x[:n], out) if pad else out
 
 
+def own_device() -> jax.Device:
+    """The device a task's model and data are placed on: this process's first. MJX's default,
+    ``jax.devices()[0]``, is process 0's under ``jax.distributed``, and an array there spans a device the
+    other processes cannot address, which no program of theirs may close over or read."""
+    return jax.local_devices()[0]
+
+
+def put_model(mj_model, impl: str | None = None):
+    """``mjx.put_model`` on ``own_device``; a task's model is built once and closed over by every program,
+    so the first use may come from inside a jit trace."""
+    from mujoco import mjx
+
+    with jax.ensure_compile_time_eval():
+        return mjx.put_model(mj_model, impl=impl, device=own_device())
+
+
+def make_data(model):
+    """``mjx.make_data`` of an MJX ``model`` on ``own_device``, in the model's implementation."""
+    from mujoco import mjx
+
+    return mjx.make_data(model, device=own_device(), impl=model.impl)
+
+
 def data_with(data, phys):
     """MJX ``data`` with the fields of a task's ``phys`` (a flax struct named as MJX's ``Data`` fields) set."""
     return data.replace(**{f.name: getattr(phys, f.name) for f in dataclasses.fields(phys)})

@@ -17,7 +17,7 @@ import jax
 import jax.numpy as jnp
 
 from envs import kernel_batch
-from envs.base import data_with
+from envs.base import data_with, make_data
 from envs.box_contacts import box_box, box_box_soa, plane_box, plane_box_soa
 from envs.fused_solver import at_mask
 from envs.mjx_patch import patched_mjx
@@ -129,7 +129,7 @@ def contacts(task, physics, fused: bool):
     MJX's functions or, if ``fused``, by this module's: what the parity checks compare."""
     from mujoco import mjx
 
-    data = data_with(mjx.make_data(task.mjx_model), physics)
+    data = data_with(make_data(task.mjx_model), physics)
     with patched_mjx(collide=groups() if fused else None):
         c = mjx.forward(task.mjx_model, data)._impl.contact
     return c.dist, c.pos, c.frame

@@ -16,7 +16,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
+from envs.base import GoalEnv, State, flag_invalid, make_data, mjx_substeps, put_model
 from envs.settings import check, check_integer
 
 LINKS = (0.1, 0.11)  # shoulder to elbow, elbow to fingertip (Gym's fingertip body sits at 0.11)
@@ -94,11 +94,9 @@ class Reacher(GoalEnv):
     @functools.cached_property
     def built(self):
         import mujoco
-        from mujoco import mjx
 
         model = mujoco.MjModel.from_xml_string(_XML.format(timestep=self.timestep))
-        with jax.ensure_compile_time_eval():  # first use may come from inside a jit trace
-            return model, mjx.put_model(model)
+        return model, put_model(model)
 
     @property
     def mj_model(self):
@@ -135,10 +133,8 @@ class Reacher(GoalEnv):
         return self._state(phys, goal, jnp.int32(0), jnp.bool_(False))
 
     def step(self, state: State, action: jax.Array) -> State:
-        from mujoco import mjx
-
         model = self.mjx_model
-        data = mjx.make_data(model).replace(ctrl=jnp.clip(action, -1.0, 1.0))
+        data = make_data(model).replace(ctrl=jnp.clip(action, -1.0, 1.0))
         phys = mjx_substeps(model, data, state.physics, self.frame_skip)
         return flag_invalid(self._state(phys, state.desired_goal, state.step + 1, state.invalid))
 

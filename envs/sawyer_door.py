@@ -32,7 +32,7 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
-from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
+from envs.base import GoalEnv, State, flag_invalid, make_data, mjx_substeps, put_model
 from envs.settings import check, check_integer
 
 GOAL_MAX = 0.83  # the largest goal angle (GCSL's multiworld settings), rad
@@ -164,11 +164,9 @@ class SawyerDoor(GoalEnv):
     @functools.cached_property
     def built(self):
         import mujoco
-        from mujoco import mjx
 
         model = mujoco.MjModel.from_xml_string(self.mjcf())
-        with jax.ensure_compile_time_eval():  # first use may come from inside a jit trace
-            return model, mjx.put_model(model, impl="jax")  # one implementation on every backend
+        return model, put_model(model, impl="jax")  # one implementation on every backend
 
     @property
     def mj_model(self):
@@ -204,13 +202,11 @@ class SawyerDoor(GoalEnv):
         return self._state(phys, goal, jnp.int32(0), jnp.bool_(False))
 
     def step(self, state: State, action: jax.Array) -> State:
-        from mujoco import mjx
-
         model = self.mjx_model
         phys = state.physics
         lo, hi = (jnp.asarray(b) for b in WORKSPACE)
         target = jnp.clip(phys.qpos[1:4] + self.action_scale * jnp.clip(action, -1.0, 1.0), lo, hi)
-        phys = mjx_substeps(model, mjx.make_data(model).replace(ctrl=target), phys, self.frame_skip)
+        phys = mjx_substeps(model, make_data(model).replace(ctrl=target), phys, self.frame_skip)
         return flag_invalid(self._state(phys, state.desired_goal, state.step + 1, state.invalid))
 
     def with_goal(self, state: State, goal: jax.Array) -> State:

@@ -358,8 +358,7 @@ def own_contacts(m: mujoco.MjModel):
 def build(kind: str, **options):
     """``(mj_model, mjx_model, layout)`` for task ``kind`` with ``mjcf``'s keyword ``options``; cached,
     so tasks stay hashable."""
-    import jax
-    from mujoco import mjx
+    from envs.base import put_model
 
     m = mujoco.MjModel.from_xml_string(mjcf(kind, **options))
     jnt = lambda name: m.joint(name)  # noqa: E731
@@ -387,6 +386,5 @@ def build(kind: str, **options):
         nv=int(m.nv),
         nu=int(m.nu),
     )
-    with jax.ensure_compile_time_eval(), own_contacts(m):  # first use may come from inside a jit trace
-        mx = mjx.put_model(m, impl="jax")
-    return m, mx, layout
+    with own_contacts(m):
+        return m, put_model(m, impl="jax"), layout

@@ -35,7 +35,7 @@ import dataclasses
 import jax
 import jax.numpy as jnp
 
-from envs.base import GoalEnv, State, flag_invalid, mjx_substeps
+from envs.base import GoalEnv, State, flag_invalid, make_data, mjx_substeps
 from envs.fetch import control, kernels, models, observation
 from envs.fetch.observation import Physics
 from envs.physics import BACKENDS, KERNELS_CHECKED, in_use, kernels_checked
@@ -279,12 +279,10 @@ class _FetchTask(GoalEnv):
 
     def simulate(self, phys: Physics, ctrl: jax.Array) -> Physics:
         """``substeps`` MJX steps from ``phys`` with control ``ctrl``."""
-        from mujoco import mjx
-
         model = self.mjx_model
 
         def step():
-            data = mjx.make_data(model)
+            data = make_data(model)
             if self.drive == "weld":  # the constraint pulls the gripper to the mocap body, put at the target
                 home = jnp.asarray(self.layout.grip_home, data.mocap_pos.dtype)
                 data = data.replace(mocap_pos=data.mocap_pos.at[0].set(home + ctrl[0:3]))

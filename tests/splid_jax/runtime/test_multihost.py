@@ -1,6 +1,7 @@
 """One sweep over two processes (``jax.distributed`` on two local CPU processes, one device each):
 process 0 alone writes, a signal to either stops both with a checkpoint, and the members' metrics are
-those of the sweep in one process. Launch options that cannot work are refused with one line."""
+those of the sweep in one process, on the point task and on an MJX one. Launch options that cannot
+work are refused with one line."""
 
 import json
 import os
@@ -22,6 +23,11 @@ TINY = ["--env", "point", "--num-envs", "4", "--eval-episodes", "8", "--eval-eve
         "--batch-size", "16", "--hidden", "16", "--seeds", "2", "--horizons", "4", "--no-plot"]  # fmt: skip
 VOLATILE = {"wall_s", "steps_per_s"}
 MEMBERS = ("sigma1-H4-s0", "sigma1-H4-s1")
+# the smallest Fetch sweep: one chunk of 4-step episodes
+REACH = ["--env", "reach", "--env-options", "max_episode_steps=4", "--num-envs", "2", "--eval-episodes", "2",
+         "--eval-every", "1", "--bc-steps", "2", "--batch-size", "8", "--hidden", "8", "--seeds", "2",
+         "--horizons", "2", "--no-plot"]  # fmt: skip
+REACH_MEMBERS = ("sigma1-H2-s0", "sigma1-H2-s1")
 
 
 def free_port() -> int:
@@ -53,6 +59,20 @@ def finish(procs, timeout: float = 120) -> list[int]:
                 q.kill()
             pytest.fail("a process of the two-process sweep hung")
     return codes
+
+
+def succeed(root, tag: str, procs, timeout: float) -> None:
+    """Every process exits 0 within ``timeout``, else all are ended and the test fails with their output: a
+    process that raised can wait at its exit for the others, as they wait for it in a collective."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and not any(p.poll() for p in procs) and any(p.poll() is None for p in procs):
+        time.sleep(0.1)
+    for p in procs:
+        p.kill()  # nothing, for one that exited
+    codes = [p.wait() for p in procs]
+    if codes != [0, 0]:
+        outs = "".join(f"\nprocess {i}:\n" + (root / f"{tag}-{i}.out").read_text()[-2000:] for i in range(len(procs)))
+        pytest.fail(f"exit codes {codes} (negative: ended after {timeout:.0f} s or a peer's failure){outs}")
 
 
 def stable(root, run, member):
@@ -100,6 +120,18 @@ def test_only_process_0_writes_and_each_member_computes_as_in_one_process(two_pr
     for i in range(2):  # no traceback, and process 1 shows nothing
         out = (root / f"resumed-{i}.out").read_text()
         assert "Traceback" not in out and ("iter " in out) == (i == 0)
+
+
+@pytest.mark.slow
+def test_an_mjx_task_runs_over_two_processes_as_in_one(tmp_path):
+    """Each process steps the task's MJX model from its own device: on process 0's, process 1 could neither
+    close over it in its programs nor read it."""
+    args = [*REACH, "--iterations", "1", "--checkpoint-every", "0", "--quiet"]
+    procs = launch(tmp_path, "reach", lambda i: [*args, "--run-dir", str(tmp_path / f"p{i}")])
+    assert sweep.main([*args, "--run-dir", str(tmp_path / "one")]) == 0  # beside the two processes' compiles
+    succeed(tmp_path, "reach", procs, timeout=180)
+    for member in REACH_MEMBERS:
+        assert stable(tmp_path, "p0", member) == stable(tmp_path, "one", member)
 
 
 @pytest.mark.parametrize("main", [sweep.main, train.main])
