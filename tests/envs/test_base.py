@@ -1,4 +1,4 @@
-"""``step_batch``: the batched step that every stage uses."""
+"""``step_batch``: the batched step that every stage uses; where a task's MJX model and data live."""
 
 
 import chex
@@ -9,7 +9,7 @@ import pytest
 
 import envs
 import envs.point_fourrooms
-from envs.base import CPU_STEP_SLICE, step_batch
+from envs.base import CPU_STEP_SLICE, make_data, put_model, step_batch
 
 
 def test_slices_give_what_one_vmap_gives():
@@ -82,3 +82,16 @@ def test_a_sliced_batch_holds_one_batched_step_however_many_envs():
         names = [e.primitive.name for e in jaxpr.jaxpr.eqns]
         # the slices' scan holds the batched step; a remainder would call it once more beside the scan
         assert names.count("scan") == 1 and not {"jit", "pjit"} & set(names), (n, names)
+
+
+def test_an_mjx_model_and_its_data_live_on_this_processs_own_device(monkeypatch):
+    """Under ``jax.distributed`` ``jax.devices()[0]``, MJX's default, is process 0's device, which another
+    process can neither read nor close over in its programs."""
+    import mujoco
+
+    xml = "<mujoco><worldbody><body><joint type='slide'/><geom size='0.1'/></body></worldbody></mujoco>"
+    model = mujoco.MjModel.from_xml_string(xml)
+    monkeypatch.setattr(jax, "devices", lambda *a, **k: pytest.fail("placed on jax.devices()'s device"))
+    placed = put_model(model, impl="jax")
+    arrays = [x for x in jax.tree.leaves((placed, make_data(placed))) if isinstance(x, jax.Array)]
+    assert arrays and all(x.devices() == {jax.local_devices()[0]} for x in arrays)
