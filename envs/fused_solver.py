@@ -262,14 +262,6 @@ def covers(m, d) -> bool:
     )
 
 
-def _local(x):
-    """A model option's value as this process holds it: a model placed over several processes' devices (a
-    sweep under jax.distributed) cannot be read whole, but every process holds a full copy."""
-    if isinstance(x, jax.Array) and not x.is_fully_addressable:
-        return x.addressable_data(0)
-    return x
-
-
 def solve(m, d, kernel: bool, num_warps: int | None = None, max_envs: int = 0):
     """``mujoco.mjx._src.solver.solve`` for the models ``covers`` takes, through ``kernel_solve`` if ``kernel``;
     with ``max_envs`` the kernel only where the innermost ``vmap`` holds at most that many envs."""
@@ -278,8 +270,8 @@ def solve(m, d, kernel: bool, num_warps: int | None = None, max_envs: int = 0):
     if kernel and max_envs:
         own = lambda x: solve(m, x, True, num_warps)  # noqa: E731
         return kernel_batch.by_batch(own, lambda x: _MJX_SOLVE(m, x), max_envs)(d)
-    opts = dict(iterations=int(_local(m.opt.iterations)), ls_iterations=int(_local(m.opt.ls_iterations)),
-                tolerance=float(_local(m.opt.tolerance)), ls_tolerance=float(_local(m.opt.ls_tolerance)))  # fmt: skip
+    opts = dict(iterations=int(m.opt.iterations), ls_iterations=int(m.opt.ls_iterations),
+                tolerance=float(m.opt.tolerance), ls_tolerance=float(m.opt.ls_tolerance))  # fmt: skip
     args = (d._impl.efc_J, d._impl.efc_D, d._impl.efc_aref, support.full_m(m, d), d.qfrc_smooth, d.qacc_smooth,
             d.qacc_warmstart, mjx_solver._trace_m(m, d))  # fmt: skip
     qacc, qfrc, force = kernel_solve(*args, num_warps=num_warps, **opts) if kernel else newton(*args, **opts)
