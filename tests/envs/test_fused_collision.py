@@ -87,40 +87,40 @@ def test_kernels_are_the_functions_and_lower_as_one_triton_call_each():
         assert lowered.as_text().count("xla.gpu.triton") == 1
 
 
-def test_push_states_get_mjxs_contacts():
-    env = envs.make("push", solver_loops="loops")
-    state = jax.jit(jax.vmap(env.reset))(jax.random.split(jax.random.PRNGKey(0), 8))
-    act, step = jax.jit(jax.vmap(CONTROLLERS["push"])), jax.jit(jax.vmap(env.step))
-    contacts = functools.partial(fused_collision.contacts, env)
-    mjxs, ours = (jax.jit(jax.vmap(functools.partial(contacts, fused=f))) for f in (False, True))
-    touching = 0
-    for k in range(8):  # the finger block meets the cube from the seventh step on
-        state = step(state, act(state.obs, state.desired_goal))
-        if k in (3, 7):
-            want, got = mjxs(state.physics), ours(state.physics)
-            np.testing.assert_allclose(got[2], want[2], atol=1e-5)
-            for e in range(8):
-                assert _contacts(*got[:2], e) == _contacts(*want[:2], e)
-            touching += int((np.asarray(want[0]) < 0).sum())
-    assert touching > 50
-
-
-def _scripted_path(**options) -> np.ndarray:
+@functools.cache
+def _scripted_run(**options):
+    """The task and its physics after each of 8 steps of 8 Push envs under the scripted pusher, with the MJX
+    solver's loops: one compiled program per choice of ``options``, read by the tests below."""
     env = envs.make("push", solver_loops="loops", **options)
-    state = jax.jit(jax.vmap(env.reset))(jax.random.split(jax.random.PRNGKey(0), 4))
+    state = jax.jit(jax.vmap(env.reset))(jax.random.split(jax.random.PRNGKey(0), 8))
     act = jax.vmap(CONTROLLERS["push"])
 
     def step(s, _):
         s = jax.vmap(env.step)(s, act(s.obs, s.desired_goal))
-        return s, s.physics.qpos
+        return s, s.physics
 
-    return np.asarray(jax.jit(lambda s: jax.lax.scan(step, s, None, length=8)[1])(state))
+    return env, jax.jit(lambda s: jax.lax.scan(step, s, None, length=8)[1])(state)
+
+
+def test_push_states_get_mjxs_contacts():
+    env, physics = _scripted_run()
+    contacts = functools.partial(fused_collision.contacts, env)
+    mjxs, ours = (jax.jit(jax.vmap(functools.partial(contacts, fused=f))) for f in (False, True))
+    touching = 0
+    for k in (3, 7):  # after the fourth step, and the eighth: the finger block meets the cube from the seventh on
+        state = jax.tree_util.tree_map(lambda x, k=k: x[k], physics)
+        want, got = mjxs(state), ours(state)
+        np.testing.assert_allclose(got[2], want[2], atol=1e-5)
+        for e in range(8):
+            assert _contacts(*got[:2], e) == _contacts(*want[:2], e)
+        touching += int((np.asarray(want[0]) < 0).sum())
+    assert touching > 50
 
 
 def test_push_path_follows_mjxs():
     # the finger block meets the cube from the seventh step on: without its contacts the path parts there by 0.017;
     # after the eighth, contact amplifies float rounding (MJX's own library Cholesky parts by 4e-3 a step later)
-    base, fused = _scripted_path(), _scripted_path(collision="fused")
+    base, fused = (np.asarray(_scripted_run(**options)[1].qpos) for options in ({}, {"collision": "fused"}))
     assert np.isfinite(fused).all()
     np.testing.assert_allclose(fused, base, atol=1e-5)
 
