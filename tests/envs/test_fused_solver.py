@@ -17,8 +17,9 @@ from tests.helpers import needs_kernels, triton_calls_in_step
 
 @functools.cache
 def _path(choice: str) -> np.ndarray:
-    """qpos over six steps of four Push envs (one substep each) with MJX's solver as ``choice`` runs it."""
-    env = envs.make("push", substeps=1, solver_loops=choice)
+    """qpos over six steps of four Push envs (one substep each) with MJX's solver as ``choice`` runs it; the
+    library's Cholesky in MJX's own solve (the fused solve factors with its own), whose programs compile faster."""
+    env = envs.make("push", substeps=1, solver_loops=choice, cholesky="library")
     state = jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, 4)))(jax.random.PRNGKey(0))
     actions = jax.random.uniform(jax.random.PRNGKey(1), (6, 4, 4), minval=-1.0, maxval=1.0)
 
