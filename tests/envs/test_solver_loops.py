@@ -19,9 +19,10 @@ from tests.helpers import needs_kernels
 def _program(choice: str):
     """Six steps of four envs with the solver's loops as ``choice`` has them: the traced episode program
     and its start. One substep keeps the written-out programs' compiles short; two Newton trips of two
-    line-search trips each tell a wrong count of either (about 1e-2). The loop checks below read this
-    program's jaxpr, so each choice that runs is traced once."""
-    env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, solver_loops=choice)
+    line-search trips each tell a wrong count of either (about 1e-2); the library's Cholesky, one operation
+    where the unrolled one is many, keeps them shorter still. The loop checks below read this program's
+    jaxpr, so each choice that runs is traced once."""
+    env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, cholesky="library", solver_loops=choice)
     state = jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, 4)))(jax.random.PRNGKey(0))
     actions = jax.random.uniform(jax.random.PRNGKey(1), (6, 4, 4), minval=-1.0, maxval=1.0)
 
@@ -52,7 +53,7 @@ def _loop_primitives(choice: str | None = None) -> set[str]:
         counts = _loop_counts(str(_program(choice)[0].jaxpr), episode_scans=1)
     else:
         options = {} if choice is None else {"solver_loops": choice}
-        env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, **options)
+        env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, cholesky="library", **options)
         state = jax.eval_shape(env.reset, jax.random.PRNGKey(0))  # its shapes are all a trace needs
         counts = _loop_counts(str(jax.make_jaxpr(env.step)(state, jnp.zeros(4))))
     return {p for p, n in counts.items() if n > 0}
