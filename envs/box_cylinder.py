@@ -15,10 +15,9 @@ the cylinder's (the fingers on an upright puck, at any yaw) that set holds the e
 an approximation whose normal errs by about the tilt where an edge crosses the rim. A normal within ``SNAP`` of the
 axis selects the cap, within ``SNAP`` of horizontal the side wall, so a box face on a slightly tilted puck (or float
 rounding in its tilt) keeps a face contact rather than a point, pushing along the box face's normal. The contact
-points then follow the feature of the
-cylinder that the normal selects: on a cap, the corners of the box's face that faces it, clipped
-to the disc along the face's edges, each at its own depth; on the side wall, the wall's vertical segment clipped
-to the box's extent along it (two points); on the rim, the rim point (one).
+points then follow the feature of the cylinder that the normal selects: on a cap, the corners of the box's face
+that faces it, clipped to the disc along the face's edges, each at its own depth; on the side wall, the wall's
+vertical segment clipped to the box's extent along it (two points); on the rim, the rim point (one).
 """
 
 from __future__ import annotations

@@ -33,6 +33,7 @@ How these compare with the reference: ``experiments/parity/README.md``.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 
@@ -72,10 +73,9 @@ FINGER_MASS = 1.0
 FINGER_DRIVES = ("reference", "fast")
 REFERENCE_FINGER_INERTIA = 104.0  # kg along the joint: the reference finger's 4 kg and its armature of 100
 REFERENCE_FINGER_DAMPING = 1000.0
-# Slide only (see the module docstring): the reference arm's effective mass at the grip site, the
-# fingertip corners that strike the puck, and their contact with it.
+# Slide only (see the module docstring): the reference arm's effective mass at the grip site (its fingers:
+# envs/fetch/slide_fingers.py).
 SLIDE_GRIPPER_MASS = 13.0
-SLIDE_TIP_XY, SLIDE_TIP_RADIUS = slide_fingers.TIP_XY, slide_fingers.TIP_RADIUS
 
 # kind -> (table centre xyz, table half-size xyz, initial grip-site position). The start positions
 # are those the reference's episodes begin from (read off its resets in experiments/parity): Push
@@ -342,8 +342,6 @@ def rest_height(m: mujoco.MjModel, object_q: int) -> float:
 def own_contacts(m: mujoco.MjModel):
     """The block within which MJX knows the contacts model ``m`` needs and it lacks (box-cylinder:
     ``envs/box_cylinder.py``); put_model, make_data and a step's trace of ``m`` must run inside it."""
-    import contextlib
-
     from envs import box_cylinder
 
     groups = box_cylinder.groups_for(m)
