@@ -113,13 +113,14 @@ def make_policy(
     normalise: bool,
     achieved_start: int | None = None,
     goal_unit: float = 1.0,
+    layer_norm: bool = False,
 ) -> Policy:
     """``achieved_start``: where the achieved goal begins in the observation (the task's
     ``achieved_goal_start``), to feed the goal relative to it; None feeds observation and goal alone."""
     achieved = None if achieved_start is None else (achieved_start, achieved_start + goal_size)
     assert achieved is None or 0 <= achieved[0] and achieved[1] <= obs_size, (achieved, obs_size)
     return Policy(
-        net=MLP(hidden=tuple(hidden), action_size=action_size),
+        net=MLP(hidden=tuple(hidden), action_size=action_size, layer_norm=layer_norm),
         in_size=obs_size + goal_size * (1 if achieved is None else 2),
         normalise=normalise,
         achieved_slice=achieved,

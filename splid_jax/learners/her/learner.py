@@ -236,7 +236,8 @@ class HER(Chunked):
         """An iteration's ``n_updates`` gradient steps. The buffer does not change between them, so their
         batches are drawn at once. Where the targets stay fixed over them (``target_every`` 0, Baselines),
         so do their TD targets, computed in one pass before the steps; otherwise each step computes its own
-        and the targets move every ``target_every`` steps."""
+        and the targets move every ``target_every`` steps; where that divides the step count, each block of
+        ``target_every`` steps takes its targets in one pass, since the target networks hold still over it."""
         if self.her.matmul_precision == "default":
             return self._updates(hs, key)
         with jax.default_matmul_precision(self.her.matmul_precision):
@@ -248,13 +249,26 @@ class HER(Chunked):
         if not her.target_every:
             return jax.lax.scan(self.train_step, hs, (batches, self.td_targets(hs, batches)))
 
+        def moved_if(hs, move):
+            moved = self._moved_targets(hs)
+            targets = _pick(move, (moved.target_actor, moved.target_critic), (hs.target_actor, hs.target_critic))
+            return hs.replace(target_actor=targets[0], target_critic=targets[1])
+
+        blocks, rest = divmod(self.n_updates, her.target_every)
+        if not rest:  # the targets hold still over each block of target_every steps: one pass for its targets
+
+            def block(hs, tr):
+                hs, losses = jax.lax.scan(self.train_step, hs, (tr, self.td_targets(hs, tr)))
+                return moved_if(hs, self.warm(hs.buffer)), losses
+
+            split = jax.tree_util.tree_map(lambda x: x.reshape(blocks, her.target_every, *x.shape[1:]), batches)
+            hs, losses = jax.lax.scan(block, hs, split)
+            return hs, jax.tree_util.tree_map(lambda x: x.reshape(self.n_updates, *x.shape[2:]), losses)
+
         def step(hs, inputs):
             i, tr = inputs
             hs, losses = self.train_step(hs, (tr, self.td_targets(hs, tr)))
-            move = ((i + 1) % her.target_every == 0) & self.warm(hs.buffer)
-            moved = self._moved_targets(hs)
-            targets = _pick(move, (moved.target_actor, moved.target_critic), (hs.target_actor, hs.target_critic))
-            return hs.replace(target_actor=targets[0], target_critic=targets[1]), losses
+            return moved_if(hs, ((i + 1) % her.target_every == 0) & self.warm(hs.buffer)), losses
 
         return jax.lax.scan(step, hs, (jnp.arange(self.n_updates), batches))
 

@@ -274,6 +274,30 @@ def test_targets_move_every_target_every_steps_only_once_warm():
         ) == moves
 
 
+def test_blocks_of_target_every_steps_equal_the_steps_one_at_a_time():
+    # each block of target_every steps takes its TD targets in one pass: as if every step computed its own
+    # from target networks that move after every target_every-th step
+    small = dict(hidden=(8,), batch_size=8, buffer_transitions=500)
+    her = _her(update_every=0, n_batches=6, target_every=3, warm_up=0, **small)
+    state = her.init(jax.random.PRNGKey(1))
+    episodes, valid, _ = jax.jit(her.explore)(state.policy, jax.random.PRNGKey(2))
+    state = state.replace(buffer=episode_buffer.buffer_insert(state.buffer, episodes, valid))
+    key = jax.random.PRNGKey(3)
+    blocked, losses = jax.jit(her.updates)(state, key)
+    batches = her.draw(state, key, her.n_updates)
+    step = jax.jit(lambda h, tr: her.train_step(h, (tr, her.td_targets(h, tr))))
+    h, critic_losses = state, []
+    for i in range(her.n_updates):
+        h, step_losses = step(h, jax.tree_util.tree_map(lambda x, i=i: x[i], batches))
+        critic_losses.append(float(step_losses["critic_loss"]))
+        if (i + 1) % 3 == 0:
+            moved = her._moved_targets(h)
+            h = h.replace(target_actor=moved.target_actor, target_critic=moved.target_critic)
+    np.testing.assert_allclose(losses["critic_loss"], critic_losses, rtol=1e-5)
+    for a, b in zip(jax.tree_util.tree_leaves(blocked), jax.tree_util.tree_leaves(h), strict=True):
+        np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-6)
+
+
 def test_the_mrl_preset_learns_the_point_task_within_400_episodes():
     """mrl's settings scaled to the CPU (narrower nets, smaller batches, a step per 8 transitions, warm-ups
     shortened in proportion). Without its gradient steps the policy would stay at its initial one, which rarely
