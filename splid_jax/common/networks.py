@@ -11,6 +11,8 @@ import jax
 import jax.numpy as jnp
 from flax import struct
 
+from splid_jax.common.layers import Dense, LayerNorm
+
 with contextlib.redirect_stdout(io.StringIO()):  # brax imports MJX, which prints a warp notice
     from brax.training.acme import running_statistics
 
@@ -36,11 +38,12 @@ class MLP(nn.Module):
     @nn.compact
     def __call__(self, x: jax.Array) -> jax.Array:
         act = getattr(nn, self.activation)
-        for width in self.hidden:
-            x = nn.Dense(width, kernel_init=nn.initializers.orthogonal(jnp.sqrt(2.0)), dtype=self.dtype)(x)
-            x = act(nn.LayerNorm(dtype=self.dtype)(x) if self.layer_norm else x)
+        for i, width in enumerate(self.hidden):  # flax's names, so parameters and checkpoints read as flax's layers'
+            x = Dense(width, nn.initializers.orthogonal(jnp.sqrt(2.0)), self.dtype, name=f"Dense_{i}")(x)
+            x = act(LayerNorm(self.dtype, name=f"LayerNorm_{i}")(x) if self.layer_norm else x)
         out_dtype = None if self.dtype is None else jnp.float32
-        x = nn.Dense(self.action_size, kernel_init=nn.initializers.orthogonal(0.01), dtype=out_dtype)(x)
+        out = Dense(self.action_size, nn.initializers.orthogonal(0.01), out_dtype, name=f"Dense_{len(self.hidden)}")
+        x = out(x)
         return jnp.tanh(x) if self.tanh_output else x
 
 
@@ -113,14 +116,13 @@ def make_policy(
     normalise: bool,
     achieved_start: int | None = None,
     goal_unit: float = 1.0,
-    layer_norm: bool = False,
 ) -> Policy:
     """``achieved_start``: where the achieved goal begins in the observation (the task's
     ``achieved_goal_start``), to feed the goal relative to it; None feeds observation and goal alone."""
     achieved = None if achieved_start is None else (achieved_start, achieved_start + goal_size)
     assert achieved is None or 0 <= achieved[0] and achieved[1] <= obs_size, (achieved, obs_size)
     return Policy(
-        net=MLP(hidden=tuple(hidden), action_size=action_size, layer_norm=layer_norm),
+        net=MLP(hidden=tuple(hidden), action_size=action_size),
         in_size=obs_size + goal_size * (1 if achieved is None else 2),
         normalise=normalise,
         achieved_slice=achieved,

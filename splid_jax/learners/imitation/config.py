@@ -116,9 +116,6 @@ class ImitationConfig:
     hidden: tuple[int, ...] = field(
         None, "hidden layer widths of the policy MLP, e.g. 64,64,64 (her: see --her-options hidden)"
     )
-    layer_norm: bool = field(
-        False, "LayerNorm after each hidden layer of the policy MLP", recorded_when_set=True, unrecorded=False
-    )
     normalise: bool = field(None, "normalise policy inputs with running mean and std")
     relative_goal: bool = field(
         None, "also feed the policy the goal minus the achieved goal (read off the observation), not only both"

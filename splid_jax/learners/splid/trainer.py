@@ -91,7 +91,6 @@ class Trainer(Chunked):
             bc.normalise,
             achieved_start=env.achieved_goal_start if bc.relative_goal else None,
             goal_unit=env.success_distance,
-            layer_norm=bc.layer_norm,
         )
         if mesh is not None:
             check(cfg.num_envs % mesh.size == 0, "num_envs", cfg.num_envs, f"a multiple of the {mesh.size} devices")

@@ -67,13 +67,3 @@ def test_relative_goal_input_is_the_goal_minus_the_achieved_goal_in_success_unit
     assert policy.act(pstate, obs, goal).shape == (1, 2)
     # the same obs and goal moved together leave the relative input as it was
     np.testing.assert_allclose(policy.features(obs.at[:, 1:3].add(0.3), goal + 0.3)[0, -2:], [2.0, -10.0], rtol=1e-4)
-
-
-def test_layer_norm_follows_each_hidden_layer_where_asked():
-    for layer_norm, norms in ((False, 0), (True, 2)):
-        policy = make_policy(OBS, GOAL, 2, (16, 16), normalise=False, layer_norm=layer_norm)
-        params = policy.init(jax.random.PRNGKey(0)).params["params"]
-        assert sum(name.startswith("LayerNorm") for name in params) == norms
-        obs, goal, _ = _data(jax.random.PRNGKey(1), 4)
-        pstate = policy.init(jax.random.PRNGKey(0))
-        assert policy.mean(pstate, obs, goal).shape == (4, 2)

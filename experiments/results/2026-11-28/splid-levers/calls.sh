@@ -1,0 +1,76 @@
+# Call 1 (4 GPUs): GPU 0 HER speed variants + kernel profile; GPUs 1-3 SPLID Push arms on tuning seeds 1000-1004
+export NCCL_NVLS_ENABLE=0 PYTHONUNBUFFERED=1
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=$PWD:/tmp/site
+W=/tmp/w; mkdir -p $W; T0=$(date +%s)
+nvidia-smi -L > $W/gpus.txt
+nvidia-cuda-mps-control -d && echo mps > $W/mps.txt
+S="python3 -m splid_jax.sweep --env push --seeds 5 --seed 1000 --iterations 80 --checkpoint-every 0 --compile-cache= --no-plot"
+arm() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$g $S --run-dir $W/arms/$n "$@" > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+mkdir -p $W/arms
+(CUDA_VISIBLE_DEVICES=0 python3 .gpu/her_speed.py $W/her_speed.json $W/trace > $W/her_speed.log 2>&1; echo "her_speed rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt
+ arm 0 default & arm 0 ln --layer-norm & arm 0 ln512 --layer-norm --hidden 512,512,512 & arm 0 bc400 --bc-steps 400 & wait) &
+arm 1 bc800 --bc-steps 800 &
+arm 1 ln_bc400 --layer-norm --bc-steps 400 &
+arm 1 w512 --hidden 512,512,512 &
+arm 1 b2048 --batch-size 2048 &
+arm 1 e63 --num-envs 63 --iterations 160 --sigma-anneal 160 --buffer-window-grow 400 &
+while [ $(( $(date +%s) - T0 )) -lt ${WAIT:-560} ] && [ $(jobs -r | wc -l) -gt 0 ]; do sleep 5; done
+cd /tmp && tar czf $OUT/c1.tgz --exclude='trace' w 2>/dev/null
+cat $W/times.txt; tail -n 2 $W/arms/*.log | grep -v "^$"; cat $W/her_speed.log | head -8
+# Call 2 (2 GPUs): SPLID Push arms on tuning seeds 1000-1004 (5 per GPU under MPS, no preallocation)
+export NCCL_NVLS_ENABLE=0 PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=$PWD:/tmp/site
+W=/tmp/w2; mkdir -p $W/arms; T0=$(date +%s)
+nvidia-cuda-mps-control -d 2>/dev/null
+S="python3 -m splid_jax.sweep --env push --seeds 5 --seed 1000 --iterations 80 --checkpoint-every 0 --compile-cache= --no-plot"
+arm() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$g $S --run-dir $W/arms/$n "$@" > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+arm 0 ln --layer-norm &
+arm 0 ln512 --layer-norm --hidden 512,512,512 &
+arm 0 bc400 --bc-steps 400 &
+arm 0 bc800 --bc-steps 800 &
+arm 0 w512 --hidden 512,512,512 &
+arm 1 ln_bc400 --layer-norm --bc-steps 400 &
+arm 1 e63 --num-envs 63 --iterations 160 --sigma-anneal 160 --buffer-window-grow 400 &
+arm 1 ln_lr1e3 --layer-norm --learning-rate 1e-3 &
+arm 1 bc400_ema99 --bc-steps 400 --policy-ema 0.99 &
+arm 1 ln512_bc400 --layer-norm --hidden 512,512,512 --bc-steps 400 &
+while [ $(( $(date +%s) - T0 )) -lt ${WAIT:-540} ] && [ $(jobs -r | wc -l) -gt 0 ]; do sleep 5; done
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -2M | tar czf $OUT/arms2.tgz -T - times.txt
+cat $W/times.txt; for f in $W/arms/*.log; do echo $f; tail -n 1 $f; done
+# Call 3 (2 GPUs): SPLID Push default on fresh seeds 7100-7104 (HER (mrl) bf16's seeds), PickAndPlace default on
+# 7000-7004 (HER (mrl)'s), and a third round of Push arms on tuning seeds 1000-1004
+export NCCL_NVLS_ENABLE=0 PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=$PWD:/tmp/site
+W=/tmp/w3; mkdir -p $W/arms; T0=$(date +%s)
+nvidia-cuda-mps-control -d 2>/dev/null
+C="--checkpoint-every 0 --compile-cache= --no-plot"
+S="python3 -m splid_jax.sweep --env push --seeds 5 --seed 1000 --iterations 80 $C"
+run() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$g "$@" --run-dir $W/arms/$n > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+arm() { g=$1; n=$2; shift 2; run $g $n $S "$@"; }
+run 0 push7100 python3 -m splid_jax.sweep --env push --seeds 5 --seed 7100 --iterations 80 $C &
+run 1 pnp7000 python3 -m splid_jax.sweep --env pick_and_place --seeds 5 --seed 7000 --iterations 40 $C &
+arm 0 bc100 --bc-steps 100 &
+arm 0 b2048_bc100 --batch-size 2048 --bc-steps 100 &
+arm 0 lr25e5 --learning-rate 2.5e-4 &
+arm 0 ema95 --policy-ema 0.95 &
+arm 1 b4096 --batch-size 4096 &
+arm 1 sig01 --sigma-end 0.1 &
+arm 1 ema99 --policy-ema 0.99 &
+arm 1 win100k --buffer-window 100000 &
+while [ $(( $(date +%s) - T0 )) -lt ${WAIT:-545} ] && [ $(jobs -r | wc -l) -gt 0 ]; do sleep 5; done
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -2M | tar czf $OUT/arms3.tgz -T - times.txt
+cat $W/times.txt; for f in $W/arms/*.log; do echo $f; tail -n 1 $f; done
+# Call 4 (2 GPUs): GPU 0 kernel profile of HER's 200 updates (5 vmapped seeds, bf16); GPU 1 SPLID Push with
+# --sigma-end 0.1 (chosen on 1000-1004) on fresh seeds 7100-7104
+export NCCL_NVLS_ENABLE=0 PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=$PWD:/tmp/site
+W=/tmp/w4; mkdir -p $W/arms; T0=$(date +%s)
+(CUDA_VISIBLE_DEVICES=1 python3 -m splid_jax.sweep --env push --seeds 5 --seed 7100 --iterations 80 --checkpoint-every 0 --compile-cache= --no-plot --sigma-end 0.1 --run-dir $W/arms/sig01_7100 > $W/arms/sig01_7100.log 2>&1; echo "sig01 rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt) &
+CUDA_VISIBLE_DEVICES=0 PROFILE_ONLY=1 python3 .gpu/her_speed.py $W/her_profile.json $W/trace > $W/her_profile.log 2>&1; echo "profile rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt
+wait
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -2M | tar czf $OUT/c4.tgz -T - times.txt her_profile.json her_profile.log
+cat times.txt; tail -n 1 arms/sig01_7100.log; tail -n 30 her_profile.log
