@@ -1,7 +1,8 @@
 """SELECT's work queue on an MJX task (Push): the lanes' verdicts equal each candidate replayed alone.
 
-The explored episodes and the lone replays both run in Push's shared episode program (conftest), so
-the only program compiled here is SELECT's own."""
+The explored episodes and the lone replays both run in a shared episode program (conftest's, of Push with
+the library's Cholesky, which test_small_cholesky runs too), so the only program compiled here is SELECT's
+own, kept short by that Cholesky."""
 
 import jax
 import jax.numpy as jnp
@@ -40,7 +41,7 @@ def explored(fetch, env) -> Trajectory:
 
 @pytest.mark.slow
 def test_push_queue_verdicts_match_single_replays(fetch):
-    env, policy, n = envs.make("push"), ScriptedPolicy(), fetch.T * fetch.B
+    env, policy, n = envs.make("push", cholesky="library"), ScriptedPolicy(), fetch.T * fetch.B
     traj = explored(fetch, env)
     cands = jax.jit(lambda tr: select(env, policy, None, tr, H, jnp.int32(H), True, 0.1))(traj)
     valid = np.asarray(cands.valid)
