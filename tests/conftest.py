@@ -56,12 +56,15 @@ def pytest_unconfigure(config):
     shutil.rmtree(config.splid_cache_home, ignore_errors=True)
 
 
-# Test files that step the same compiled programs (``FetchEpisodes``'s Push program below): one xdist
-# work unit, so they run on one worker and the program compiles once (about 20 s each time it doesn't).
+# Test files that step the same compiled programs (``FetchEpisodes``'s Push programs below, and
+# helpers.solver_program's): one xdist work unit each, so they run on one worker and each program
+# compiles once.
 SHARED_PROGRAMS = {
     "tests/envs/test_fetch_tasks.py": "fetch-episodes",
     "tests/envs/test_small_cholesky.py": "fetch-episodes",
     "tests/splid_jax/learners/splid/test_select_mjx.py": "fetch-episodes",
+    "tests/envs/test_solver_loops.py": "solver-paths",
+    "tests/envs/test_fused_solver.py": "solver-paths",
 }
 # The longest units' seconds on a 2-core CPU (a full run's --durations, summed per unit). They go out
 # first, longest first, so the last units handed out are short and the two workers end together (in

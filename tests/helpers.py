@@ -3,10 +3,14 @@ compute fast, and small measures shared by several test files."""
 
 from __future__ import annotations
 
+import functools
+
 import jax
 import jax.numpy as jnp
+import numpy as np
 import pytest
 
+import envs
 from envs import physics
 from envs.base import GoalEnv, State
 from splid_jax.common.networks import Policy, PolicyState
@@ -93,3 +97,28 @@ def triton_calls_for_gpu(env: GoalEnv, monkeypatch, batch: tuple[int, ...] = (4,
 def triton_calls_in_step(env: GoalEnv, monkeypatch, batch: tuple[int, ...] = (4,)) -> tuple[int, int]:
     """How many Triton kernel calls ``env``'s batched step holds as traced on this CPU and as traced for a GPU."""
     return _triton_calls(env, batch, gpu=False), triton_calls_for_gpu(env, monkeypatch, batch)
+
+
+@functools.cache
+def solver_program(choice: str):
+    """Six steps of four Push envs with the MJX solver's loops as ``choice`` has them: the traced episode
+    program and its start. One substep keeps the written-out programs' compiles short; two Newton trips of
+    two line-search trips each tell a wrong count of either (about 1e-2); the library's Cholesky, one
+    operation where the unrolled one is many, keeps them shorter still. The loops' program is the reference
+    of test_solver_loops and test_fused_solver alike (conftest puts the two files on one worker)."""
+    env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, cholesky="library", solver_loops=choice)
+    state = jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, 4)))(jax.random.PRNGKey(0))
+    actions = jax.random.uniform(jax.random.PRNGKey(1), (6, 4, 4), minval=-1.0, maxval=1.0)
+
+    def step(s, a):
+        s = jax.vmap(env.step)(s, a)
+        return s, s.physics.qpos
+
+    return jax.jit(lambda s: jax.lax.scan(step, s, actions)[1]).trace(state), state
+
+
+@functools.cache
+def solver_path(choice: str) -> np.ndarray:
+    """The qpos path [6, 4, nq] of ``solver_program(choice)``, computed once for every test reading it."""
+    traced, state = solver_program(choice)
+    return np.asarray(traced.lower().compile()(state))

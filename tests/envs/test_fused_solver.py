@@ -12,26 +12,11 @@ import numpy as np
 import envs
 from envs import fused_solver
 from envs.fetch.kernels import runs_as_kernel
-from tests.helpers import needs_kernels, triton_calls_in_step
-
-
-@functools.cache
-def _path(choice: str) -> np.ndarray:
-    """qpos over six steps of four Push envs (one substep each) with MJX's solver as ``choice`` runs it; the
-    library's Cholesky in MJX's own solve (the fused solve factors with its own), whose programs compile faster."""
-    env = envs.make("push", substeps=1, solver_loops=choice, cholesky="library")
-    state = jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, 4)))(jax.random.PRNGKey(0))
-    actions = jax.random.uniform(jax.random.PRNGKey(1), (6, 4, 4), minval=-1.0, maxval=1.0)
-
-    def step(s, a):
-        s = jax.vmap(env.step)(s, a)
-        return s, s.physics.qpos
-
-    return np.asarray(jax.jit(lambda s: jax.lax.scan(step, s, actions)[1])(state))
+from tests.helpers import needs_kernels, solver_path, triton_calls_in_step
 
 
 def test_fused_solve_follows_mjx_path():
-    fused, loops = _path("fused"), _path("loops")
+    fused, loops = solver_path("fused"), solver_path("loops")  # two trips: a miscounted one parts them
     assert np.isfinite(fused).all()
     np.testing.assert_allclose(fused, loops, atol=1e-5)
 

@@ -3,8 +3,6 @@ and nothing else swapped."""
 
 from __future__ import annotations
 
-import functools
-
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -12,32 +10,7 @@ import pytest
 
 import envs
 from envs import solver_loops
-from tests.helpers import needs_kernels
-
-
-@functools.cache
-def _program(choice: str):
-    """Six steps of four envs with the solver's loops as ``choice`` has them: the traced episode program
-    and its start. One substep keeps the written-out programs' compiles short; two Newton trips of two
-    line-search trips each tell a wrong count of either (about 1e-2); the library's Cholesky, one operation
-    where the unrolled one is many, keeps them shorter still. The loop checks below read this program's
-    jaxpr, so each choice that runs is traced once."""
-    env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, cholesky="library", solver_loops=choice)
-    state = jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, 4)))(jax.random.PRNGKey(0))
-    actions = jax.random.uniform(jax.random.PRNGKey(1), (6, 4, 4), minval=-1.0, maxval=1.0)
-
-    def step(s, a):
-        s = jax.vmap(env.step)(s, a)
-        return s, s.physics.qpos
-
-    return jax.jit(lambda s: jax.lax.scan(step, s, actions)[1]).trace(state), state
-
-
-@functools.cache
-def _path(choice: str):
-    """The qpos path of ``_program(choice)``; the loops' path is computed once for both written-out choices."""
-    traced, state = _program(choice)
-    return np.asarray(traced.lower().compile()(state))
+from tests.helpers import needs_kernels, solver_path, solver_program
 
 
 def _loop_counts(text: str, episode_scans: int = 0) -> dict[str, int]:
@@ -50,7 +23,7 @@ def _loop_primitives(choice: str | None = None) -> set[str]:
     episode program that runs (less its episode scan) where the tests run that choice, else from a
     trace of the lone step."""
     if choice in ("loops", "unrolled", "search"):
-        counts = _loop_counts(str(_program(choice)[0].jaxpr), episode_scans=1)
+        counts = _loop_counts(str(solver_program(choice)[0].jaxpr), episode_scans=1)
     else:
         options = {} if choice is None else {"solver_loops": choice}
         env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, cholesky="library", **options)
@@ -69,7 +42,7 @@ def test_written_out_solver_leaves_no_loop_in_the_step():
 
 @needs_kernels
 def test_written_out_line_search_keeps_the_newton_loop_alone():
-    counts = _loop_counts(str(_program("search")[0].jaxpr), episode_scans=1)
+    counts = _loop_counts(str(solver_program("search")[0].jaxpr), episode_scans=1)
     assert counts == {"while[": 1, "scan[": 1}  # the Newton loop and the substeps'
 
 
@@ -85,7 +58,7 @@ def test_gpu_choices_write_the_solver_out_on_a_gpu_only():
 
 @pytest.mark.parametrize("choice", ["unrolled", "search"])
 def test_written_out_solver_follows_the_loops_path(choice):
-    loops, written = _path("loops"), _path(choice)
+    loops, written = solver_path("loops"), solver_path(choice)
     assert np.isfinite(written).all()
     np.testing.assert_allclose(written, loops, atol=1e-5)
 
