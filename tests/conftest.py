@@ -66,30 +66,33 @@ SHARED_PROGRAMS = {
     "tests/envs/test_solver_loops.py": "solver-paths",
     "tests/envs/test_fused_solver.py": "solver-paths",
 }
-# The longest units' seconds on a 2-core CPU (a full run's --durations, summed per unit). They go out
-# first, longest first, so the last units handed out are short and the two workers end together (in
-# the order of collection, a worker once sat idle for the last 90 s). Only the order depends on these.
+# The longest units' seconds on a 2-core CPU shared with other work (a full run's --durations, summed per
+# unit; one that ran beside a busy neighbour reads long). They go out first, longest first, so the last
+# units handed out are short and the two workers end together (in the order of collection, a worker once
+# sat idle for the last 90 s). Only the order depends on these.
 UNIT_SECONDS = {
-    "fetch-episodes": 78,
-    "tests/splid_jax/test_train.py": 51,
-    "tests/envs/test_fused_collision.py": 40,
-    "tests/splid_jax/learners/her/test_her.py": 40,
-    "solver-paths": 36,
-    "tests/splid_jax/runtime/test_run_files.py": 27,
-    "tests/envs/test_kernel_batch.py": 26,
-    "tests/splid_jax/test_figures.py": 21,
-    "tests/splid_jax/learners/splid/test_trainer.py": 21,
-    "tests/splid_jax/runtime/test_multihost.py": 20,
-    "tests/splid_jax/test_rollout.py": 20,
-    "tests/splid_jax/learners/test_algos.py": 19,
-    "tests/splid_jax/runtime/test_devices.py": 18,
-    "tests/splid_jax/reference/test_cli.py": 17,
-    "tests/splid_jax/runtime/test_programs.py": 15,
-    "tests/splid_jax/test_sweep.py": 14,
-    "tests/splid_jax/runtime/test_loop.py": 12,
-    "tests/envs/test_reacher.py": 12,
+    "fetch-episodes": 155,
+    "tests/splid_jax/runtime/test_multihost.py": 108,
+    "tests/splid_jax/test_train.py": 92,
+    "tests/splid_jax/learners/her/test_her.py": 65,
+    "tests/splid_jax/learners/test_algos.py": 61,
+    "solver-paths": 57,
+    "tests/envs/test_fused_collision.py": 56,
+    "tests/splid_jax/runtime/test_programs.py": 41,
+    "tests/splid_jax/runtime/test_devices.py": 40,
+    "tests/splid_jax/reference/test_cli.py": 40,
+    "tests/envs/test_reacher.py": 38,
+    "tests/splid_jax/test_rollout.py": 37,
+    "tests/envs/test_kernel_batch.py": 32,
+    "tests/splid_jax/runtime/test_loop.py": 32,
+    "tests/splid_jax/learners/splid/test_trainer.py": 31,
+    "tests/splid_jax/test_figures.py": 27,
+    "tests/splid_jax/runtime/test_run_files.py": 25,
+    "tests/splid_jax/learners/test_es.py": 25,
+    "tests/splid_jax/test_sweep.py": 21,
+    "tests/envs/test_slide_fingers.py": 14,
+    "tests/splid_jax/runtime/test_checkpoint.py": 13,
     "tests/test_hang_watchdog.py": 11,
-    "tests/splid_jax/learners/test_es.py": 9,
 }
 
 
