@@ -45,7 +45,7 @@ def launch(root, tag: str, args_of) -> list[subprocess.Popen]:
     return procs
 
 
-def finish(procs, timeout: float = 120) -> list[int]:
+def finish(procs, timeout: float = 180) -> list[int]:
     """Exit codes; a process still running after ``timeout`` (a hang) is killed and fails the test."""
     deadline, codes = time.monotonic() + timeout, []
     for p in procs:
@@ -72,9 +72,9 @@ def two_processes(tmp_path_factory) -> dict:
     root = tmp_path_factory.mktemp("two_processes")
     run_dirs = [str(root / "p0"), str(root / "p1")]
     first = launch(root, "first", lambda i: [*TINY, "--iterations", "1000", "--run-dir", run_dirs[i]])
-    deadline = time.monotonic() + 120
+    deadline = time.monotonic() + 180
     while "iter " not in (root / "first-0.out").read_text() and first[0].poll() is None:
-        assert time.monotonic() < deadline, "no chunk within 120 s"
+        assert time.monotonic() < deadline, "no chunk within 180 s"
         time.sleep(0.05)
     first[1].send_signal(signal.SIGTERM)
     stopped = finish(first)
