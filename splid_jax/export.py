@@ -18,9 +18,9 @@ import sys
 import tempfile
 from collections.abc import Sequence
 
-from splid_jax.cli import Parser, check_environment, exit_with, quiet_interrupts, run_main
+from splid_jax.cli import Parser, check_environment, exit_with, flag_error, quiet_interrupts, run_main
 from splid_jax.common.errors import InvalidConfig, check
-from splid_jax.common.paths import is_utf8
+from splid_jax.common.paths import is_utf8, unwritable
 from splid_jax.common.values import options_text
 from splid_jax.runtime.run_files import EXPORT, METRICS, env_settings, write_json
 
@@ -95,17 +95,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     from splid_jax.reference.extra import EvaluationError
     from splid_jax.runtime.checkpoint import CheckpointError, is_no_space, write_failure
 
-    ns = build_parser().parse_args(argv)
+    parser = build_parser()
+    ns = parser.parse_args(argv)
     names = [os.path.basename(os.path.abspath(d)) for d in ns.run_dirs]
     try:
         check(bool(ns.out.strip()), "out", ns.out, "a directory to write the exports in")
         check(is_utf8(ns.out), "out", ns.out, "a path of UTF-8 text (checkpoints are written under it)")
+        why = unwritable(ns.out)  # a file, or a file on its way, fails here rather than after the first export
+        check(why is None, "out", ns.out, f"a directory that can be made and written in ({why})")
         check(len(set(names)) == len(names), "run_dirs", " ".join(ns.run_dirs), "runs of distinct directory names")
         for run_dir, name in zip(ns.run_dirs, names, strict=True):
             record = export(run_dir, os.path.join(ns.out, name), ns.step)
             print(f"{run_dir} (iteration {record['step']}) -> {os.path.join(ns.out, name)}")
     except (InvalidConfig, EvaluationError, CheckpointError) as e:
-        print(f"python -m splid_jax.export: error: {e}", file=sys.stderr)
+        print(f"{parser.prog}: error: {flag_error(e, parser) if isinstance(e, InvalidConfig) else e}", file=sys.stderr)
         return 2
     except Exception as e:  # a full or read-only disk under --out: nothing of that export is left behind
         failure = write_failure(e)

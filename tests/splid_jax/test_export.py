@@ -61,7 +61,7 @@ def test_an_export_is_refused_over_an_existing_directory_and_for_resume(tmp_path
     (tmp_path / "out" / "run").mkdir(parents=True)
     assert export.main([str(run), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "invalid out=" in err and "does not exist yet" in err
+    assert len(err.splitlines()) == 1 and "invalid --out " in err and "does not exist yet" in err
     assert export.main([str(run), "--out", str(tmp_path / "new")]) == 0
     assert train.main(["--resume", str(tmp_path / "new" / "run"), "--iterations", "6"]) == 2
     err = capsys.readouterr().err.strip()
@@ -105,5 +105,15 @@ def test_a_failed_export_is_one_line_and_leaves_nothing_half_written(tmp_path, c
 def test_an_empty_or_undecodable_out_is_refused(tmp_path, capsys, monkeypatch, out):
     monkeypatch.chdir(tmp_path)
     assert export.main([str(tmp_path / "run"), "--out", out]) == 2
-    assert f"invalid out={out!r}" in capsys.readouterr().err
+    assert f"invalid --out {out!r}" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("under", ["", "sub"], ids=["a-file", "under-a-file"])
+def test_an_out_that_is_a_file_is_one_line_before_any_run_is_read(tmp_path, capsys, under):
+    (tmp_path / "taken").write_text("kept")
+    out = tmp_path / "taken" / under if under else tmp_path / "taken"
+    assert export.main([str(tmp_path / "no-run"), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and f"invalid --out {out}: must be a directory" in err
+    assert (tmp_path / "taken").read_text() == "kept"
