@@ -37,7 +37,7 @@ from splid_jax.config import PROVENANCE, RETIRED, TrainConfig  # noqa: E402
 from splid_jax.presets import TUNED, TUNED_LEARNERS  # noqa: E402
 from splid_jax.runtime import checkpoint, loop, multihost, progress  # noqa: E402
 from splid_jax.runtime.loop import RunStopped  # noqa: E402
-from splid_jax.runtime.run_files import EXPORT, MAY_CHANGE_ON_RESUME, env_settings  # noqa: E402
+from splid_jax.runtime.run_files import EXPORT, MAY_CHANGE_ON_RESUME, SWEEP, env_settings  # noqa: E402
 
 __all__ = ["RunStopped", "build_parser", "config_from_cli", "env_settings", "main", "run"]
 
@@ -99,6 +99,10 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
         raise InvalidConfig("resume", ns.resume, "a run directory holding config.json")
     if os.path.isfile(os.path.join(ns.resume, EXPORT)):
         why = f"a run train wrote, not an export without its buffer (its {EXPORT} names the run)"
+        raise InvalidConfig("resume", ns.resume, why)
+    sweep = os.path.dirname(os.path.abspath(ns.resume))
+    if os.path.isfile(os.path.join(sweep, SWEEP)):  # its checkpoints are the sweep's: a run of its own would replace it
+        why = f"a run train wrote, not a member of a sweep (continue it: python -m splid_jax.sweep --resume {sweep})"
         raise InvalidConfig("resume", ns.resume, why)
     names = {f.name for f in TrainConfig.settings_fields()}
     try:

@@ -436,3 +436,17 @@ def test_a_gpu_compiler_failing_on_the_solve_kernel_is_one_line(tmp_path, capsys
     assert main([*TINY, "--iterations", "5", "--run-dir", str(tmp_path / "run")]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "--env-options" in err and "another solver (Triton)" in err
+
+
+def test_resuming_a_sweeps_member_is_refused_and_changes_nothing(tmp_path, capsys):
+    member = tmp_path / "sweep" / "m0"
+    member.mkdir(parents=True)
+    (tmp_path / "sweep" / "sweep.json").write_text("{}")
+    config = json.dumps(TrainConfig(env="point", iterations=5, eval_every=5, run_dir=str(member)).to_json())
+    (member / "config.json").write_text(config)
+    (member / "metrics.jsonl").write_text('{"iteration": 5}\n')
+    assert main(["--resume", str(member), "--iterations", "10"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "not a member of a sweep" in err and "sweep --resume" in err
+    assert (member / "config.json").read_text() == config and (member / "metrics.jsonl").read_text().count("\n") == 1
+    assert sorted(p.name for p in member.iterdir()) == ["config.json", "metrics.jsonl"]
