@@ -134,9 +134,25 @@ def check_run_dir(cfg: TrainConfig, resume: bool) -> int | None:
     if not holds_run(cfg.run_dir):
         raise InvalidConfig("resume", cfg.run_dir, "a run directory holding a checkpoint or its config.json")
     step = checkpoint.latest_step(cfg.run_dir)
+    if step is None:
+        check_restartable(cfg)
     if step is not None and step > cfg.iterations:
         raise InvalidConfig("iterations", cfg.iterations, f">= {step}, the iterations {cfg.run_dir} has completed")
     return step
+
+
+def check_restartable(cfg: TrainConfig) -> None:
+    """A run without a checkpoint starts again, its records dropped: refused where they are more than the
+    chunks a run writes before its first checkpoint is whole (its checkpoints were deleted, say)."""
+    path = recorded(cfg.run_dir)
+    if path is None or not cfg.checkpoint_every:
+        return
+    with open(path, "rb") as fh:
+        records = sum(1 for line in fh if line.strip())
+    if records > cfg.checkpoint_every + 1:  # one checkpoint may still be under way beside the next chunk
+        why = (f"a run with a checkpoint to continue from ({path} holds {records} records but there is no "
+               "checkpoint; move it away to start the run again)")  # fmt: skip
+        raise InvalidConfig("resume", cfg.run_dir, why)
 
 
 def check_writable(run_dir: str) -> None:

@@ -142,3 +142,21 @@ def test_an_undecodable_or_foreign_file_is_one_line_and_exit_2(tmp_path, capsys,
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "Traceback" not in err, err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("records, code", [(3, 2), (2, 0)], ids=["checkpoints-deleted", "killed-in-the-gap"])
+def test_records_beyond_the_gap_without_a_checkpoint_are_not_dropped(tmp_path, capsys, records, code):
+    from splid_jax.config import TrainConfig
+    from splid_jax.runtime.run_files import check_run_dir
+
+    cfg = TrainConfig(env="point", iterations=15, eval_every=5, run_dir=str(tmp_path))
+    (tmp_path / "config.json").write_text(json.dumps(cfg.to_json()))
+    lines = "".join(f'{{"iteration": {5 * i}}}\n' for i in range(1, records + 1))
+    (tmp_path / "metrics.jsonl").write_text(lines)
+    if code == 0:  # at most a chunk past the first checkpoint under way: the run starts again
+        assert check_run_dir(cfg, resume=True) is None
+        return
+    assert train.main(["--resume", str(tmp_path), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"invalid --resume {tmp_path}: must be a run with a checkpoint" in err
+    assert (tmp_path / "metrics.jsonl").read_text() == lines
