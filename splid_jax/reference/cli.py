@@ -12,6 +12,7 @@ import sys
 
 import numpy as np
 
+from splid_jax.cli import Parser, flag_error
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.reference.episodes import summarise
 from splid_jax.reference.extra import EXTRA, REFERENCE_IDS, EvaluationError, import_reference
@@ -42,11 +43,10 @@ def _line(name: str, s: dict) -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = Parser(
         prog="python -m splid_jax.evaluate",
         description="Evaluate a run's deterministic policy in the reference simulator (Gymnasium-Robotics "
         "Fetch*-v4) and in our task, with 95 %% intervals.",
-        allow_abbrev=False,
     )
     p.add_argument("run_dir", metavar="RUN_DIR", nargs="?", default=None)
     p.add_argument("--scripted", metavar="TASK", choices=sorted(REFERENCE_IDS), default=None,
@@ -68,6 +68,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--traces", default=None, metavar="FILE.npz",
                    help="also trace both simulators from the same starts and goals (distance to goal, object "
                    "speed, grip position per step) and the grip's response to a held action")  # fmt: skip
+    p.add_argument("--overwrite", action="store_true", help="replace an --out or --traces file that already exists")
     return p
 
 
@@ -102,12 +103,16 @@ def main(argv: list[str] | None = None) -> int:
             raise EvaluationError("give either RUN_DIR or --scripted TASK")
         if a.episodes < 1:
             raise EvaluationError(f"--episodes {a.episodes}: must be >= 1")
+        if not 0 <= a.seed < 2**32:  # JAX's keys and Gymnasium's resets take no other
+            raise EvaluationError(f"--seed {a.seed}: must be an integer in [0, 2**32)")
         if a.run_dir is not None and not os.path.isdir(a.run_dir):
             raise EvaluationError(f"{a.run_dir} is not a directory")
         out = a.out or (os.path.join(a.run_dir, "reference.json") if a.run_dir else f"scripted-{a.scripted}.json")
         for flag, path in (("--out", out), ("--traces", a.traces)):
             if path is not None and not os.path.isdir(_folder(path)):
                 raise EvaluationError(f"{flag} {path}: its directory does not exist")
+            if path is not None and os.path.exists(path) and not a.overwrite:  # an earlier evaluation's
+                raise EvaluationError(f"{flag} {path}: already exists (pass --overwrite to replace it)")
         if a.scripted:
             result, tr = scripted(a.scripted, a.episodes, a.seed)
             title = f"the scripted {a.scripted} controller, the same {a.episodes} starts in each"
@@ -122,7 +127,7 @@ def main(argv: list[str] | None = None) -> int:
                 pol = lambda o, g: policy.act(pstate, o, g)  # noqa: E731
                 tr = traces(env, cfg.env, pol, policy_act(policy, pstate), a.episodes, a.seed)
     except (EvaluationError, InvalidConfig, CheckpointError) as err:
-        print(f"{p.prog}: error: {err}", file=sys.stderr)
+        print(f"{p.prog}: error: {flag_error(err, p) if isinstance(err, InvalidConfig) else err}", file=sys.stderr)
         return 2
     print(title + ":")
     print(_line("ours (MJX)", result["ours"]))

@@ -130,3 +130,36 @@ def test_evaluator_on_push_and_the_scripted_push_in_both_simulators(tmp_path, ca
     np.testing.assert_allclose(ours.obs[:, 0, :9], ref.obs[:, 0, :9], atol=2e-3)  # same start, same layout
     np.testing.assert_allclose(ours.goal, ref.goal, atol=2e-3)
     assert ours.success[:, -1].all() and ref.success[:, -1].all()
+
+
+def test_an_earlier_result_is_kept_unless_overwrite_is_given(tmp_path, capsys, monkeypatch):
+    side = {"episodes": 1, "success_any": 1.0, "success_any_ci95": [0.2, 1.0], "success_final": 1.0,
+            "success_final_ci95": [0.2, 1.0], "median_final_distance": 0.01}  # fmt: skip
+    monkeypatch.setattr(cli, "scripted", lambda *a: ({"reference": "FetchReach-v4", "ours": side, "fetch": side}, {}))
+    out = tmp_path / "r.json"
+    out.write_text("earlier")
+    argv = ["--scripted", "reach", "--reference", "--episodes", "1", "--out", str(out)]
+    assert f"--out {out}: already exists (pass --overwrite" in _error(capsys, argv)
+    assert out.read_text() == "earlier"
+    assert cli.main([*argv, "--overwrite"]) == 0 and json.loads(out.read_text())["fetch"]["episodes"] == 1
+
+
+@pytest.mark.parametrize(
+    "argv, said",
+    [
+        (["--seed", "-1"], "--seed -1: must be an integer in [0, 2**32)"),
+        (["--eval-subgoal-reach", "-1"], "invalid --eval-subgoal-reach -1.0: must be a distance >= 0"),
+        (["--scripted", "pushh"], "argument --scripted: invalid choice: 'pushh'"),
+    ],
+)
+def test_a_bad_flag_is_one_line_naming_it(tmp_path, capsys, argv, said):
+    run = _init_run(tmp_path / "run", "reach")
+    if argv[0] == "--scripted":
+        run_args = ["--reference", *argv]
+        with pytest.raises(SystemExit) as stop:
+            cli.main(run_args)
+        err = capsys.readouterr().err.strip()
+        assert stop.value.code == 2 and err.count("\n") == 0 and said in err, err
+        return
+    assert said in _error(capsys, [str(run), "--reference", "--episodes", "1", *argv])
+    assert not (run / "reference.json").exists()
