@@ -9,13 +9,12 @@ Needs the optional extra: ``pip install -e ".[tensorboard]"`` (tensorboardX).
 
 from __future__ import annotations
 
-from splid_jax.cli import check_environment, exit_with, quiet_interrupts, run_main
+from splid_jax.cli import Parser, check_environment, exit_with, quiet_interrupts, run_main
 
 if __name__ == "__main__":  # a signal while it loads or works ends the process with one line, no traceback
     quiet_interrupts("")
     check_environment()
 
-import argparse  # noqa: E402
 import contextlib  # noqa: E402
 import math  # noqa: E402
 import os  # noqa: E402
@@ -140,7 +139,7 @@ def convert(metrics_path: str, log_dir: str) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m splid_jax.tensorboard", description=__doc__.splitlines()[0])
+    p = Parser(prog="python -m splid_jax.tensorboard", description=__doc__.splitlines()[0])
     p.add_argument("metrics", metavar="METRICS.jsonl")
     p.add_argument("log_dir", metavar="OUT_DIR")
     a = p.parse_args(argv)

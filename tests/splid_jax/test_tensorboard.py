@@ -168,3 +168,11 @@ def test_a_torn_last_line_is_dropped(tmp_path, capsys):
     metrics.write_text(json.dumps(RECORDS[0]) + "\n" + json.dumps(RECORDS[1])[:20])
     assert tensorboard.main([str(metrics), str(tmp_path / "tb")]) == 0
     assert "1 records" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv", [[], ["a.jsonl", "out", "extra"], ["--bogus", "a.jsonl", "out"]])
+def test_a_bad_command_line_is_one_line_pointing_at_help(capsys, argv):
+    with pytest.raises(SystemExit) as stop:
+        tensorboard.main(argv)
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and len(err.splitlines()) == 1 and "--help" in err, err
