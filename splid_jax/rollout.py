@@ -21,7 +21,7 @@ import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
 
 from envs.base import step_batch  # noqa: E402
-from splid_jax.cli import Parser, add_compile_cache_flag, use_compile_cache  # noqa: E402
+from splid_jax.cli import Parser, add_compile_cache_flag, flag_error, use_compile_cache  # noqa: E402
 from splid_jax.common.errors import InvalidConfig  # noqa: E402
 from splid_jax.common.paths import unreadable  # noqa: E402
 from splid_jax.common.subgoals import steered  # noqa: E402
@@ -322,7 +322,7 @@ def main(argv: list[str] | None = None) -> int:
             if os.path.exists(path) and not a.overwrite:
                 raise InvalidConfig("out", path, "a file that does not exist yet (or pass --overwrite)")
     except (InvalidConfig, checkpoint.CheckpointError) as err:
-        print(f"{p.prog}: error: {err}", file=sys.stderr)
+        print(f"{p.prog}: error: {flag_error(err, p) if isinstance(err, InvalidConfig) else err}", file=sys.stderr)
         return 2
     policy = steered(trainer.policy, env, cfg.eval_subgoal_reach)  # as the run's evaluations acted
     states = jax.jit(lambda ps, k: rollout(env, policy, ps, k, a.episodes))(state.policy, jax.random.PRNGKey(a.seed))

@@ -12,7 +12,7 @@ import sys
 from collections.abc import Sequence
 
 import envs
-from splid_jax.cli import Parser, add_compile_cache_flag, interrupts_now, use_compile_cache
+from splid_jax.cli import Parser, add_compile_cache_flag, flag_error, interrupts_now, use_compile_cache
 from splid_jax.common.errors import InvalidConfig, check
 from splid_jax.figures.drawing import render
 from splid_jax.figures.merging import merge
@@ -162,7 +162,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             interrupts_now(f"after training ({out} is whole; --replot draws its figure)")
             png, table = render(out, ns.quiet)
     except InvalidConfig as err:
-        print(f"{parser.prog}: error: {err}", file=sys.stderr)
+        print(f"{parser.prog}: error: {flag_error(err, parser)}", file=sys.stderr)
         return 2
     except loop.Interrupted as stop:
         progress.show(f"stopped; continue with: python -m splid_jax.figures {ns.figure} --out {out} --resume", ns.quiet)

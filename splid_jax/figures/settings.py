@@ -58,7 +58,10 @@ def parse_sets(items: Sequence[str], methods: Sequence[str]) -> dict[str | None,
             value = value.replace(",", ":")
         elif kind != "str":
             value = read_value(value)
-        out.setdefault(method or None, {})[name] = typed_value(name, kind, value)
+        try:
+            out.setdefault(method or None, {})[name] = typed_value(name, kind, value)
+        except InvalidConfig as err:  # named as typed: the --set item, not the field alone
+            raise InvalidConfig("set", item, err.allowed) from None
     return out
 
 

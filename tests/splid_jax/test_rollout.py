@@ -84,7 +84,7 @@ def test_rollout_bad_out_fails_before_any_work(tmp_path, capsys, monkeypatch, ou
     monkeypatch.setattr(rollout, "load_config", no_work)
     assert rollout.main([str(tmp_path), "--out", str(tmp_path / out)]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "invalid out=" in err and allowed in err
+    assert err.count("\n") == 1 and "invalid --out " in err and allowed in err
     assert _files(tmp_path) == []
 
 
@@ -259,7 +259,7 @@ def test_rollout_refuses_what_it_cannot_do_before_rolling_out(point_run, capsys,
     before = _files(point_run)
     assert rollout.main([str(point_run), *args]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and f"invalid {field}=" in err
+    assert len(err.splitlines()) == 1 and f"invalid --{field} " in err
     assert _files(point_run) == before
 
 
@@ -277,7 +277,7 @@ def test_rollout_of_a_run_in_a_read_only_directory_says_so_before_rolling_out(po
     monkeypatch.setattr(rollout, "rollout", lambda *a, **kw: pytest.fail("rolled out"))
     assert rollout.main([str(point_run), "--episodes", "4", "--overwrite"]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "invalid out=" in err and "writable" in err
+    assert len(err.splitlines()) == 1 and "invalid --out " in err and "writable" in err
 
 
 def test_rollout_help_explains_run_dir_and_seed(capsys):
