@@ -205,11 +205,18 @@ def add_config_flags(
             where.add_argument(flag, type=_TYPES[f.type], default=None, help=help_text, metavar=f.name.upper())
 
 
-def refuse_unread(given: dict, algo: str) -> None:
-    """A setting given on the command line that ``algo`` does not read is a mistake, not a no-op."""
+def refuse_unread(given: dict, algo: str, namespace: argparse.Namespace | None = None) -> None:
+    """A setting given on the command line that ``algo`` does not read is a mistake, not a no-op; one of
+    another learner's own flags (``add_learner_flags``) is named as typed (``--her-batch-size``)."""
     from splid_jax.common.errors import InvalidConfig
     from splid_jax.learners import registry
 
+    for key, value in vars(namespace or argparse.Namespace()).items():
+        options, _, name = key.partition(":")
+        owner = next((x for x in registry.LEARNERS.values() if name and x.options == options), None)
+        if owner is not None and value is not None and owner.name != algo:
+            field = f"{options.removesuffix('_options')}_{name}"
+            raise InvalidConfig(field, value, f"unset unless --algo {owner.name} (this run's is {algo})")
     learner = registry.get(algo)
     for name in registry.ignores(algo):
         if name in given:

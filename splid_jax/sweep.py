@@ -276,7 +276,7 @@ def main(argv: list[str] | None = None) -> int:
             check_same_grid(lanes, ns.seeds, ns.sigmas, ns.horizons, varied_values(ns.vary, cfg.algo))
         else:
             algo = given.get("algo", "splid")
-            refuse_unread(given, algo)
+            refuse_unread(given, algo, ns)
             for name, field in (("sigmas", "sigma"), ("horizons", "horizon")):
                 check(getattr(ns, name) is None or registry.reads(algo, field), name, getattr(ns, name),
                       f"unset with --algo {algo}, which does not read {field}")  # fmt: skip

@@ -84,7 +84,7 @@ def build_parser() -> argparse.ArgumentParser:
 def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
     given = explicit_values(TrainConfig, ns)
     if ns.resume is None:
-        refuse_unread(given, given.get("algo", "splid"))
+        refuse_unread(given, given.get("algo", "splid"), ns)
         return TrainConfig(**given), False
     if not ns.resume.strip():
         raise InvalidConfig("resume", ns.resume, "a run directory holding config.json")
@@ -120,7 +120,7 @@ def config_from_cli(ns: argparse.Namespace) -> tuple[TrainConfig, bool]:
     for k, v in given.items():
         if k not in MAY_CHANGE_ON_RESUME and v != saved.get(k) and not (isinstance(v, tuple) and list(v) == saved[k]):
             raise InvalidConfig(k, v, f"{saved.get(k)!r} as in the run being resumed (only iterations may change)")
-    refuse_unread(given, saved.get("algo", "splid"))
+    refuse_unread(given, saved.get("algo", "splid"), ns)
     return TrainConfig.from_json(saved, **given, run_dir=ns.resume), True
 
 

@@ -130,6 +130,7 @@ def test_cli_rejects_a_bad_grid(capsys, tmp_path):
         (["--sigmas", "1,1.0"], "sigmas"),
         (["--algo", "gcsl", "--horizons", "2,4"], "horizons"),  # GCSL selects nothing: H is not read
         (["--algo", "her", "--sigmas", "0.5"], "sigmas"),
+        (["--her-batch-size", "64"], "her_batch_size"),  # another learner's own flag, as typed
     ],
 )
 def test_cli_names_the_field_of_a_bad_value(capsys, tmp_path, args, field):

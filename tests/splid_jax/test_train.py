@@ -92,6 +92,8 @@ def final_params(run_dir):
         (["--iterations", str(10**20)], "--iterations "),
         (["--batch-size", "2000000000"], "--batch-size 2000000000"),  # the sizes named are the ones given
         (["--env-options", "success_radius=1,success_radius=2"], "--env-options "),  # which one was meant?
+        (["--her-batch-size", "64"], "invalid --her-batch-size 64: must be unset unless --algo her"),  # as typed
+        (["--algo", "gcsl", "--her-layer-norm"], "invalid --her-layer-norm True: must be unset unless --algo her"),
     ],
 )
 def test_bad_values_stop_before_any_work(tmp_path, capsys, args, field):
