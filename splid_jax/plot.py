@@ -259,29 +259,32 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
     try:
-        ns = build_parser().parse_args(argv)
+        ns = parser.parse_args(argv)
     except SystemExit as e:  # argparse already printed usage or help
         return int(e.code or 0)
     try:
         runs = [load_run(d) for d in ns.run_dirs]
     except PlotError as e:
-        print(f"plot: {e}", file=sys.stderr)
+        print(f"{parser.prog}: error: {e}", file=sys.stderr)
         return 2
     out = ns.out or os.path.join(ns.run_dirs[0], "curves.png")
     formats = Figure().canvas.get_supported_filetypes()
     if os.path.splitext(out)[1].lstrip(".").lower() not in formats:
-        print(f"plot: --out {out}: not an image file name (end it in .png, .pdf or .svg)", file=sys.stderr)
+        why = "not an image file name (end it in .png, .pdf or .svg)"
+        print(f"{parser.prog}: error: --out {out}: {why}", file=sys.stderr)
         return 2
     if ns.out is not None and os.path.exists(out) and not ns.overwrite:
-        print(f"plot: --out {out}: a file that does not exist yet (or pass --overwrite)", file=sys.stderr)
+        why = "a file that does not exist yet (or pass --overwrite)"
+        print(f"{parser.prog}: error: --out {out}: {why}", file=sys.stderr)
         return 2
     try:
         if os.path.dirname(out):
             os.makedirs(os.path.dirname(out), exist_ok=True)
         figure(runs, ns.smooth, ns.group, ns.steps).savefig(out, dpi=110)
     except OSError as e:
-        print(f"plot: cannot write {out}: {e.strerror or e}", file=sys.stderr)
+        print(f"{parser.prog}: error: cannot write {out}: {e.strerror or e}", file=sys.stderr)
         return 2
     progress.show(out)
     return 0

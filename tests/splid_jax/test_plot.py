@@ -223,3 +223,8 @@ def test_out_that_is_not_an_image_is_refused(tmp_path, capsys):
     assert plot.main([str(run), "--out", str(run / "metrics.jsonl")]) == 2
     assert capsys.readouterr().err.count("\n") == 1
     assert (run / "metrics.jsonl").read_text().count("\n") == 12
+
+
+def test_an_error_line_is_in_the_commands_style(tmp_path, capsys):
+    assert plot.main([str(tmp_path / "absent")]) == 2
+    assert capsys.readouterr().err.startswith("python -m splid_jax.plot: error: ")
