@@ -266,10 +266,21 @@ def default_compile_cache() -> str:
     return os.path.join(base, "splid_jax", "jax")
 
 
+def _cache_dir(path: str) -> str:
+    """A directory, or a path one can be made at: JAX only warns, program by program, of one it cannot use."""
+    here = os.path.abspath(path) if path else ""
+    while here and not os.path.exists(here):
+        here = os.path.dirname(here)
+    if here and not os.path.isdir(here):
+        raise argparse.ArgumentTypeError(f"{path!r} is not a directory ({here} is a file); '' turns the cache off")
+    return path
+
+
 def add_compile_cache_flag(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--compile-cache",
         metavar="DIR",
+        type=_cache_dir,
         default=default_compile_cache(),
         help="keep compiled programs in DIR, so a rerun with the same task and shapes skips most of "
         "its compilation ('' turns it off; default: %(default)s). On a CPU, one run with its progress display on "

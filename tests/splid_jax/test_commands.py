@@ -49,3 +49,16 @@ def test_ctrl_c_in_a_command_that_trains_nothing_is_one_line(tmp_path, command):
                       f"runpy.run_module('splid_jax.{command}', run_name='__main__', alter_sys=True)")  # fmt: skip
     done = python(stops_at_parse, str(tmp_path))
     assert done.returncode == 130 and done.stderr == "interrupted (SIGINT)\n", done.stderr
+
+
+@pytest.mark.parametrize("under", ["", "sub"], ids=["a-file", "under-a-file"])
+def test_a_compile_cache_that_is_a_file_is_one_line_before_any_work(tmp_path, capsys, under):
+    from splid_jax import train
+
+    (tmp_path / "taken").write_text("kept")
+    cache = tmp_path / "taken" / under if under else tmp_path / "taken"
+    with pytest.raises(SystemExit) as stop:
+        train.main(["--env", "point", "--compile-cache", str(cache), "--run-dir", str(tmp_path / "run")])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and len(err.splitlines()) == 1 and "argument --compile-cache: " in err, err
+    assert (tmp_path / "taken").read_text() == "kept" and not (tmp_path / "run").exists()
