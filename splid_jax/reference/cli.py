@@ -14,6 +14,7 @@ import numpy as np
 
 from splid_jax.cli import Parser, flag_error
 from splid_jax.common.errors import InvalidConfig
+from splid_jax.common.paths import unwritable
 from splid_jax.reference.episodes import summarise
 from splid_jax.reference.extra import EXTRA, REFERENCE_IDS, EvaluationError, import_reference
 from splid_jax.reference.policy import evaluate, load_run, policy_act
@@ -111,6 +112,9 @@ def main(argv: list[str] | None = None) -> int:
         for flag, path in (("--out", out), ("--traces", a.traces)):
             if path is not None and not os.path.isdir(_folder(path)):
                 raise EvaluationError(f"{flag} {path}: its directory does not exist")
+            why = None if path is None else unwritable(_folder(path))
+            if why:  # said before the episodes, not after them
+                raise EvaluationError(f"{flag} {path}: its directory cannot be written in ({why})")
             if path is not None and os.path.exists(path) and not a.overwrite:  # an earlier evaluation's
                 raise EvaluationError(f"{flag} {path}: already exists (pass --overwrite to replace it)")
         if a.scripted:

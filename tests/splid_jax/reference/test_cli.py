@@ -163,3 +163,11 @@ def test_a_bad_flag_is_one_line_naming_it(tmp_path, capsys, argv, said):
         return
     assert said in _error(capsys, [str(run), "--reference", "--episodes", "1", *argv])
     assert not (run / "reference.json").exists()
+
+
+def test_an_out_in_a_directory_without_write_permission_is_one_line_before_any_episode(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(cli, "scripted", lambda *a: pytest.fail("evaluated before --out was checked"))
+    monkeypatch.setattr(cli, "unwritable", lambda d: "Permission denied" if d == str(tmp_path) else None)
+    argv = ["--scripted", "reach", "--reference", "--out", str(tmp_path / "r.json")]
+    said = f"--out {tmp_path / 'r.json'}: its directory cannot be written in (Permission denied)"
+    assert said in _error(capsys, argv)
