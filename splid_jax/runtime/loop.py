@@ -105,7 +105,7 @@ def run(
     ``members``: the configs of a sweep's members (each its own seed, run_dir and traced settings),
     trained in lock-step as one vmapped program with checkpoints under ``cfg.run_dir``. Over several
     processes every process calls it alike and each returns the records; only process 0 writes and shows."""
-    with Signals() as signals, lock.hold(cfg.run_dir, multihost.is_first()):
+    with Signals() as signals, lock.hold(cfg.run_dir, multihost.is_first(), "resume" if resume else "run_dir"):
         env = env or signals.wait(cfg.make_env)
         place = placement(cfg, None if members is None else len(members), algo)
         split_envs = place.axis == devices.ENVS and place.count > 1

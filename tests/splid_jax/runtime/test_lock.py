@@ -62,3 +62,18 @@ def test_a_lock_on_a_new_directory_leaves_nothing_behind(tmp_path):
     with lock.hold(str(tmp_path / "a" / "b")):
         assert os.listdir(tmp_path / "a" / "b") == [lock.LOCK]
     assert os.listdir(tmp_path) == []
+
+
+def test_a_resume_of_a_run_in_use_names_resume(holder, capsys):
+    import json
+
+    from splid_jax.config import TrainConfig
+
+    proc, run_dir = holder
+    config = json.dumps(TrainConfig(env="point", iterations=5, eval_every=5, run_dir=str(run_dir)).to_json())
+    (run_dir / "config.json").write_text(config)
+    assert train.main(["--resume", str(run_dir), "--iterations", "10"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and f"invalid --resume {run_dir}: " in err and f"process {proc.pid}" in err
+    assert sorted(os.listdir(run_dir)) == sorted([lock.LOCK, "config.json"])
+    assert (run_dir / "config.json").read_text() == config
