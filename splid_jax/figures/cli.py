@@ -197,7 +197,15 @@ def new_record(ns: argparse.Namespace, spec, env_name: str, out: str, today: str
     values = parse_values(spec, ns.values)
     check_out(out)
     seeds = 5 if ns.seeds is None else ns.seeds
-    plans = plan(spec, env_name, methods, seeds, budget, sets, out, values, ns.quick)
+    try:
+        plans = plan(spec, env_name, methods, seeds, budget, sets, out, values, ns.quick)
+    except InvalidConfig as err:  # a setting refused as its run's config is built: named as the user typed it
+        if values and err.field == spec.vary:
+            raise InvalidConfig("values", ns.values, err.allowed) from None
+        typed = [item for item in ns.set if item.partition("=")[0].rpartition(".")[2].replace("-", "_") == err.field]
+        if typed:
+            raise InvalidConfig("set", typed[-1], err.allowed) from None
+        raise
     os.makedirs(out, exist_ok=True)
     return {
         "figure": ns.figure,

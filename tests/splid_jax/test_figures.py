@@ -149,6 +149,8 @@ def named(field: str) -> str:
         (["fig3", "--set", "es.bc_steps=3"], "set"),
         (["fig3", "--values", "1,2"], "values"),
         (["fig4", "--values", "1,x"], "values"),
+        (["fig4", "--values", "0,2"], "values"),  # refused as the runs' configs are built: named as typed
+        (["fig3", "--set", "splid.sigma=-1"], "set"),
         (["fig3", "--seeds", "0"], "seeds"),
         (["fig3", "--episodes", "0"], "episodes"),
         (["fig3", "--env", "push"], "env"),
