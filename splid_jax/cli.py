@@ -119,7 +119,22 @@ def flag_error(err, parser: argparse.ArgumentParser) -> str:
     if not str(value) or not str(value).isprintable() or str(value).encode(errors="replace").decode() != str(value):
         value = repr(value)  # empty, or a name no terminal shows as typed: quoted, with its escapes
     head = f"{flag(err.field)} {value}" if flag(err.field) else f"{err.field}={err.value!r}"
+    if not flag(err.field) and _options_flag(err.field, flags):  # a key of an options text: as it was typed
+        head = f"{_options_flag(err.field, flags)} {err.field.partition('.')[2]}={value}"
     return f"invalid {head}: must be {typed(err.allowed)}"
+
+
+def _options_flag(field: str, flags: set[str]) -> str | None:
+    """The flag whose ``KEY=VALUE`` text holds ``field`` (``her.replay_k``: ``--her-options``; a task's
+    ``push.substeps``: ``--env-options``), or None."""
+    owner, dot, key = field.partition(".")
+    if not dot or not key:
+        return None
+    if f"--{owner}-options" in flags:
+        return f"--{owner}-options"
+    import envs
+
+    return "--env-options" if "--env-options" in flags and owner in envs.names() else None
 
 
 def readers(name: str) -> str | None:

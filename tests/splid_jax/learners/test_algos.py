@@ -81,7 +81,7 @@ def test_each_algo_writes_the_schema_and_resumes_bit_for_bit(tmp_path, algo):
     "args,field",
     [
         (["--algo", "her", "--her-options", "batch_size=0"], "her.batch_size"),
-        (["--algo", "her", "--her-options", "bogus=1"], "her.bogus="),  # no flag of that name
+        (["--algo", "her", "--her-options", "bogus=1"], "--her-options bogus="),  # no flag of that name: as typed
         (["--algo", "her", "--her-options", "gamma=big"], "her.gamma"),
         (["--algo", "her", "--her-options", "hidden=16,x"], "her.hidden"),
         (["--algo", "her", "--her-options", "n_batches"], "her_options"),
@@ -91,7 +91,7 @@ def test_each_algo_writes_the_schema_and_resumes_bit_for_bit(tmp_path, algo):
         (["--algo", "her", "--es-options", "population=8"], "es_options"),
         (["--algo", "es", "--num-envs", "8"], "num_envs"),  # the population sets it
         (["--algo", "her", "--her-batch-size", "0"], "her.batch_size"),
-        (["--algo", "splid", "--her-batch-size", "32"], "her_options"),
+        (["--algo", "splid", "--her-batch-size", "32"], "her.batch_size"),  # as typed
         (["--algo", "her", "--hidden", "16"], "hidden"),  # HER's networks are her_options'
         (["--algo", "es", "--sigma", "0.5"], "sigma"),
     ],
