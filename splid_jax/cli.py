@@ -84,6 +84,22 @@ class Parser(argparse.ArgumentParser):
     def __init__(self, **kw):
         super().__init__(allow_abbrev=False, **kw)
 
+    def parse_known_args(self, args=None, namespace=None):
+        """A value with a leading minus that argparse would take for a flag (``--values -1,2``) is joined to
+        its flag (``--values=-1,2``), so that the value's own check names the flag."""
+        words, joined = list(sys.argv[1:] if args is None else args), []
+        takes_one = {o for a in self._actions if a.option_strings and a.nargs is None for o in a.option_strings}
+        i = 0
+        while i < len(words):
+            word = words[i]
+            if word in takes_one and i + 1 < len(words) and re.fullmatch(r"-[\d.][\d.,eE+\-]*", words[i + 1]):
+                joined.append(f"{word}={words[i + 1]}")
+                i += 2
+            else:
+                joined.append(word)
+                i += 1
+        return super().parse_known_args(joined, namespace)
+
     def error(self, message: str):
         """The mistake in one line and where the usage is, not the whole usage before it."""
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")

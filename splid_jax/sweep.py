@@ -22,7 +22,6 @@ import itertools  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import os  # noqa: E402
-import re  # noqa: E402
 import sys  # noqa: E402
 
 from splid_jax import plot  # noqa: E402
@@ -146,21 +145,6 @@ def _values(field: str, text: str, kind: type) -> tuple:
         raise InvalidConfig(field, text, f"comma-separated {what}, e.g. {'2,8' if kind is int else '0.5,1'}") from None
 
 
-def _join_negative(argv: list[str]) -> list[str]:
-    """``--sigmas -1,1`` as ``--sigmas=-1,1``: argparse takes a leading minus for a flag, and the
-    value's range check then names the field."""
-    out, skip = [], False
-    for i, word in enumerate(argv):
-        if skip:
-            skip = False
-        elif word in ("--sigmas", "--horizons") and i + 1 < len(argv) and re.fullmatch(r"-[\d.][\d.,\-]*", argv[i + 1]):
-            out.append(f"{word}={argv[i + 1]}")
-            skip = True
-        else:
-            out.append(word)
-    return out
-
-
 def build_parser() -> Parser:
     parser = Parser(
         prog="python -m splid_jax.sweep",
@@ -266,7 +250,7 @@ def check_same_grid(
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    ns = parser.parse_args(_join_negative(sys.argv[1:] if argv is None else argv))
+    ns = parser.parse_args(argv)
     use_compile_cache(ns.compile_cache)
     try:
         start_processes(ns)

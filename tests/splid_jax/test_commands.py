@@ -62,3 +62,14 @@ def test_a_compile_cache_that_is_a_file_is_one_line_before_any_work(tmp_path, ca
     err = capsys.readouterr().err
     assert stop.value.code == 2 and len(err.splitlines()) == 1 and "argument --compile-cache: " in err, err
     assert (tmp_path / "taken").read_text() == "kept" and not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("args, said", [(["--hidden", "-5,4"], "invalid --hidden -5,4: must be one or more widths"),
+                                        (["--sigma", "-1e-3"], "invalid --sigma -0.001: must be >= 0")])  # fmt: skip
+def test_a_negative_value_is_taken_as_the_flags_value_and_named(tmp_path, capsys, args, said):
+    from splid_jax import train
+
+    assert train.main(["--env", "point", *args, "--run-dir", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and said in err, err
+    assert not (tmp_path / "run").exists()

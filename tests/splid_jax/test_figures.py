@@ -150,6 +150,7 @@ def named(field: str) -> str:
         (["fig3", "--values", "1,2"], "values"),
         (["fig4", "--values", "1,x"], "values"),
         (["fig4", "--values", "0,2"], "values"),  # refused as the runs' configs are built: named as typed
+        (["fig5", "--values", "-1,2"], "values"),  # a leading minus is a value, not a flag
         (["fig3", "--set", "splid.sigma=-1"], "set"),
         (["fig3", "--seeds", "0"], "seeds"),
         (["fig3", "--episodes", "0"], "episodes"),
