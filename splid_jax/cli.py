@@ -115,7 +115,12 @@ class Parser(argparse.ArgumentParser):
 
 def flag_error(err, parser: argparse.ArgumentParser) -> str:
     """An ``InvalidConfig`` as the user typed it: ``invalid --iterations 3: must be a multiple of
-    --eval-every 5``. Settings that are no flag of ``parser`` keep their own names."""
+    --eval-every 5``. Settings that are no flag of ``parser`` keep their own names; any other error is its
+    own message."""
+    from splid_jax.common.errors import InvalidConfig
+
+    if not isinstance(err, InvalidConfig):
+        return str(err)
     flags = {option for action in parser._actions for option in action.option_strings}
 
     def flag(name: str) -> str | None:

@@ -213,8 +213,8 @@ def _resolve(c) -> None:
     if learner.settings is HerConfig:  # runs recorded before the setting read "baselines" (from_json)
         c.her_defaults = c.her_defaults or "mrl"
         check(c.her_defaults in HER_DEFAULTS, "her_defaults", c.her_defaults, " or ".join(HER_DEFAULTS))
-    her = learner.settings is HerConfig
-    check(her or c.her_defaults is None, "her_defaults", c.her_defaults, "unset unless algo=her")
+    else:
+        check(c.her_defaults is None, "her_defaults", c.her_defaults, "unset unless algo=her")
     for other in registry.LEARNERS.values():  # each learner's own settings, refused for another
         text = getattr(c, other.options) if other.options else ""
         check(not text or other is learner, other.options, text, f"empty unless algo={other.name}")

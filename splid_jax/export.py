@@ -108,7 +108,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             record = export(run_dir, os.path.join(ns.out, name), ns.step)
             print(f"{run_dir} (iteration {record['step']}) -> {os.path.join(ns.out, name)}")
     except (InvalidConfig, EvaluationError, CheckpointError) as e:
-        print(f"{parser.prog}: error: {flag_error(e, parser) if isinstance(e, InvalidConfig) else e}", file=sys.stderr)
+        print(f"{parser.prog}: error: {flag_error(e, parser)}", file=sys.stderr)
         return 2
     except Exception as e:  # a full or read-only disk under --out: nothing of that export is left behind
         failure = write_failure(e)

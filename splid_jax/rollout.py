@@ -322,7 +322,7 @@ def main(argv: list[str] | None = None) -> int:
             if os.path.exists(path) and not a.overwrite:
                 raise InvalidConfig("out", path, "a file that does not exist yet (or pass --overwrite)")
     except (InvalidConfig, checkpoint.CheckpointError) as err:
-        print(f"{p.prog}: error: {flag_error(err, p) if isinstance(err, InvalidConfig) else err}", file=sys.stderr)
+        print(f"{p.prog}: error: {flag_error(err, p)}", file=sys.stderr)
         return 2
     policy = steered(trainer.policy, env, cfg.eval_subgoal_reach)  # as the run's evaluations acted
     states = jax.jit(lambda ps, k: rollout(env, policy, ps, k, a.episodes))(state.policy, jax.random.PRNGKey(a.seed))

@@ -131,7 +131,7 @@ def main(argv: list[str] | None = None) -> int:
                 pol = lambda o, g: policy.act(pstate, o, g)  # noqa: E731
                 tr = traces(env, cfg.env, pol, policy_act(policy, pstate), a.episodes, a.seed)
     except (EvaluationError, InvalidConfig, CheckpointError) as err:
-        print(f"{p.prog}: error: {flag_error(err, p) if isinstance(err, InvalidConfig) else err}", file=sys.stderr)
+        print(f"{p.prog}: error: {flag_error(err, p)}", file=sys.stderr)
         return 2
     print(title + ":")
     print(_line("ours (MJX)", result["ours"]))
