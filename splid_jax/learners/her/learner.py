@@ -202,23 +202,22 @@ class HER(Chunked):
 
     def train_step(self, hs: HerState, batch: tuple[Transitions, jax.Array]) -> tuple[HerState, dict]:
         """One gradient step of critic and actor, both from the same batch at the same parameters (as
-        Baselines computes them in one pass); none before the buffer is ``warm``."""
+        Baselines computes them in one pass)."""
         tr, target = batch
         c_loss, a_loss, q_mean, c_grad, a_grad = self.losses(hs.policy.params, hs.critic, hs.policy, tr, target)
         c_upd, critic_opt = self.critic_opt.update(c_grad, hs.critic_opt, hs.critic)
         a_upd, actor_opt = self.actor_opt.update(a_grad, hs.actor_opt, hs.policy.params)
-        old = (hs.critic, hs.critic_opt, hs.policy.params, hs.actor_opt)
-        new = (
-            optax.apply_updates(hs.critic, c_upd),
-            critic_opt,
-            optax.apply_updates(hs.policy.params, a_upd),
-            actor_opt,
-        )
-        critic, critic_opt, actor, actor_opt = _pick(self.warm(hs.buffer), new, old)
         hs = hs.replace(
-            critic=critic, critic_opt=critic_opt, policy=hs.policy.replace(params=actor), actor_opt=actor_opt
+            critic=optax.apply_updates(hs.critic, c_upd),
+            critic_opt=critic_opt,
+            policy=hs.policy.replace(params=optax.apply_updates(hs.policy.params, a_upd)),
+            actor_opt=actor_opt,
         )
         return hs, {"critic_loss": c_loss, "actor_loss": a_loss, "q_mean": q_mean}
+
+    @staticmethod
+    def _learnt(hs: HerState) -> tuple:
+        return hs.critic, hs.critic_opt, hs.policy.params, hs.actor_opt
 
     def draw(self, hs: HerState, key: jax.Array, n: int) -> Transitions:
         """``n`` batches, each from its own key as one at a time would draw it."""
@@ -233,15 +232,24 @@ class HER(Chunked):
         return jax.vmap(one)(jax.random.split(key, n))
 
     def updates(self, hs: HerState, key: jax.Array) -> tuple[HerState, dict]:
-        """An iteration's ``n_updates`` gradient steps. The buffer does not change between them, so their
-        batches are drawn at once. Where the targets stay fixed over them (``target_every`` 0, Baselines),
-        so do their TD targets, computed in one pass before the steps; otherwise each step computes its own
-        and the targets move every ``target_every`` steps; where that divides the step count, each block of
-        ``target_every`` steps takes its targets in one pass, since the target networks hold still over it."""
+        """An iteration's ``n_updates`` gradient steps, kept once the buffer is ``warm`` (before that the
+        networks and optimisers stay as they were; the losses are those of the discarded steps). The buffer
+        does not change between the steps, so the warm-up is decided once for all of them (a selection per
+        step costs a pass over every parameter and moment), and their batches are drawn at once. Where the
+        targets stay fixed over them (``target_every`` 0, Baselines), so do their TD targets, computed in
+        one pass before the steps; otherwise the targets move every ``target_every`` steps; where that
+        divides the step count, each block of ``target_every`` steps takes its targets in one pass, since
+        the target networks hold still over it."""
         if self.her.matmul_precision == "default":
-            return self._updates(hs, key)
-        with jax.default_matmul_precision(self.her.matmul_precision):
-            return self._updates(hs, key)
+            stepped, losses = self._updates(hs, key)
+        else:
+            with jax.default_matmul_precision(self.her.matmul_precision):
+                stepped, losses = self._updates(hs, key)
+        critic, critic_opt, actor, actor_opt = _pick(self.warm(hs.buffer), self._learnt(stepped), self._learnt(hs))
+        stepped = stepped.replace(
+            critic=critic, critic_opt=critic_opt, policy=stepped.policy.replace(params=actor), actor_opt=actor_opt
+        )
+        return stepped, losses
 
     def _updates(self, hs: HerState, key: jax.Array) -> tuple[HerState, dict]:
         her = self.her
