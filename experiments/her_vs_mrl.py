@@ -64,6 +64,7 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--run", action="append", default=[], help="TASK=SWEEP_DIR of our HER (mrl's settings)")
     p.add_argument("--baselines", action="append", default=[], help="TASK=SWEEP_DIR of our HER (Baselines' settings)")
+    p.add_argument("--label", default="ours, mrl settings", help="legend label of the --run curves")
     p.add_argument("--out", required=True)
     args = p.parse_args()
     ours, base = pairs(args.run), pairs(args.baselines)
@@ -72,7 +73,7 @@ def main() -> None:
     fig, axes = plt.subplots(1, len(tasks), figsize=(5.2 * len(tasks), 4.2), squeeze=False)
     rows = []
     for ax, task in zip(axes[0], tasks, strict=True):
-        for label, runs, colour in (("ours, mrl settings", ours, "C0"), ("ours, Baselines settings", base, "C2")):
+        for label, runs, colour in ((args.label, ours, "C0"), ("ours, Baselines settings", base, "C2")):
             if task not in runs:
                 continue
             c = curves(runs[task])
