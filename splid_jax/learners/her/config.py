@@ -64,6 +64,7 @@ class HerConfig:
         object.__setattr__(self, "hidden", tuple(int(w) for w in self.hidden))
         for name in ("replay_k", "actual_k", "actual_warm_up", "update_every", "n_batches", "target_every"):
             check(getattr(self, name) >= 0, f"her.{name}", getattr(self, name), "an integer >= 0")
+        check(self.update_every or self.n_batches >= 1, "her.n_batches", self.n_batches, ">= 1 when her.update_every=0")
         for name in ("random_transitions", "warm_up"):
             check(getattr(self, name) >= 0, f"her.{name}", getattr(self, name), "an integer >= 0")
         precisions = ("default", "float32", "tensorfloat32", "bfloat16")

@@ -70,6 +70,9 @@ class HER(Chunked):
         self.env, self.cfg, self.her = env, cfg, her
         self.capacity = her.buffer_transitions // T
         self.n_updates = her.updates_per_iteration(cfg.num_envs * T)
+        if her.update_every:
+            per = f"at most the {cfg.num_envs * T} transitions an iteration collects (num_envs={cfg.num_envs} x {T})"
+            check(self.n_updates >= 1, "her.update_every", her.update_every, per)
         nets = dict(hidden=her.hidden, activation="relu", layer_norm=her.layer_norm)
         if her.compute_dtype != "float32":
             nets["dtype"] = her.compute_dtype

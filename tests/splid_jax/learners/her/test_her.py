@@ -196,6 +196,12 @@ def test_config_errors_name_the_field():
         HerConfig(polyak=1.5)
     with pytest.raises(InvalidConfig, match="her.buffer_transitions"):
         HER(PointFourRooms(), TrainConfig(**CFG), HerConfig(buffer_transitions=10))
+    # settings that leave an iteration without a gradient step
+    with pytest.raises(InvalidConfig, match="her.n_batches"):
+        HerConfig(update_every=0, n_batches=0)
+    with pytest.raises(InvalidConfig, match="her.update_every"):
+        HER(PointFourRooms(), TrainConfig(**{**CFG, "num_envs": 2}), HerConfig(update_every=101))
+    assert HER(PointFourRooms(), TrainConfig(**{**CFG, "num_envs": 2}), HerConfig(update_every=100)).n_updates == 1
 
 
 def test_futureactual_mix_draws_a_fifth_real_two_fifths_future_two_fifths_stored_goals():
