@@ -122,10 +122,17 @@ def flag_error(err, parser: argparse.ArgumentParser) -> str:
     if not isinstance(err, InvalidConfig):
         return str(err)
     flags = {option for action in parser._actions for option in action.option_strings}
+    # a positional argument shows as its name in the usage line (``RUN_DIR``); one of several by its singular
+    positional = {}
+    for a in parser._actions:
+        if not a.option_strings:
+            positional[a.dest] = a.metavar or a.dest.upper()
+            if a.nargs in ("+", "*") and a.dest.endswith("s"):
+                positional[a.dest[:-1]] = positional[a.dest]
 
     def flag(name: str) -> str | None:
         typed = "--" + name.replace(".", "-").replace("_", "-")
-        return typed if typed in flags else None
+        return typed if typed in flags else positional.get(name)
 
     def named(match: re.Match) -> str:
         return f"{flag(match[1])} {match[2]}" if flag(match[1]) else match[0]

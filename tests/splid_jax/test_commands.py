@@ -73,3 +73,16 @@ def test_a_negative_value_is_taken_as_the_flags_value_and_named(tmp_path, capsys
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and said in err, err
     assert not (tmp_path / "run").exists()
+
+
+def test_an_error_in_a_positional_argument_names_it_as_the_usage_line_does():
+    from splid_jax.cli import Parser, flag_error
+    from splid_jax.common.errors import InvalidConfig
+
+    one, several = Parser(prog="one"), Parser(prog="several")
+    one.add_argument("run_dir")
+    several.add_argument("run_dirs", nargs="+", metavar="RUN_DIR")
+    err = InvalidConfig("run_dir", "/x", "a run directory holding config.json")
+    assert flag_error(err, one) == "invalid RUN_DIR /x: must be a run directory holding config.json"
+    assert flag_error(err, several) == "invalid RUN_DIR /x: must be a run directory holding config.json"
+    assert flag_error(InvalidConfig("seed", 1, "even"), one) == "invalid seed=1: must be even"
