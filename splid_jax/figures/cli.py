@@ -63,7 +63,10 @@ def build_parser() -> Parser:
         "--env", default=None, help="task: " + ", ".join(envs.names()) + " (default push; fig8, fig9, --quick: point)"
     )
     parser.add_argument(
-        "--methods", default=None, help="fig3: a comma-separated subset of " + ", ".join(METHODS) + " (default: all)"
+        "--methods",
+        default=None,
+        help="fig3: a comma-separated list among " + ", ".join(METHODS) + " (default: all but her-baselines, "
+        "HER at OpenAI Baselines' settings, the paper's, to draw beside the default HER at mrl's)",
     )
     parser.add_argument("--seeds", type=int, default=None, help="seeds per method or setting (default: 5)")
     parser.add_argument(
@@ -189,7 +192,7 @@ def new_record(ns: argparse.Namespace, spec, env_name: str, out: str, today: str
         methods = spec.methods
     else:
         check(ns.figure == "fig3", "methods", ns.methods, "given only for fig3")
-        methods = parse_methods(ns.methods, spec.methods)
+        methods = parse_methods(ns.methods, tuple(METHODS))
     budget = ns.episodes
     if budget is None:
         budget = QUICK_EPISODES if ns.quick else default_budget(env_name)

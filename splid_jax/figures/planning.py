@@ -27,6 +27,7 @@ QUICK_FIELDS: dict[str, Any] = dict(
 )
 QUICK_METHOD_FIELDS: dict[str, dict[str, Any]] = {
     "her": dict(her_options="hidden=32,32,batch_size=64,update_every=0,n_batches=10,buffer_transitions=20000"),
+    "her-baselines": dict(her_options="hidden=32,32,batch_size=64,n_batches=10,buffer_transitions=20000"),
     "es": dict(es_options="population=16"),
 }
 

@@ -17,9 +17,12 @@ METHODS: dict[str, Method] = {
     "splid": Method("SPLID", {"algo": "splid", "select": True}),
     "gcsl": Method("GCSL", {"algo": "gcsl"}),
     "pchid": Method("PCHID", {"algo": "pchid"}),
-    "her": Method("HER (DDPG + HER)", {"algo": "her"}),
+    "her": Method("HER", {"algo": "her"}),  # its legend also names whose settings it ran: mrl's or Baselines'
+
     "es": Method("ES (OpenAI-ES)", {"algo": "es"}),
     "no-select": Method("SPLID without SELECT", {"algo": "splid", "select": False}),
+    # the HER of the paper's Figure 3 beside the default one: --methods ...,her,her-baselines
+    "her-baselines": Method("HER (Baselines)", {"algo": "her", "preset": "paper"}),
 }
 
 
@@ -36,7 +39,7 @@ class Spec:
 
 SUCCESS = (("eval_success", "success at any step"), ("eval_success_final", "success at the final step"))
 SPECS: dict[str, Spec] = {
-    "fig3": Spec("SPLID against its baselines", tuple(METHODS), SUCCESS),
+    "fig3": Spec("SPLID against its baselines", ("splid", "gcsl", "pchid", "her", "es", "no-select"), SUCCESS),
     "fig4": Spec("SPLID's learning horizon H", ("splid",), SUCCESS, "horizon", (1, 2, 4, 8, 16)),
     "fig5": Spec("SPLID's exploration factor sigma", ("splid",), SUCCESS, "sigma", (0.25, 0.5, 1.0, 2.0)),
     "fig6": Spec("SPLID with and without SELECT", ("splid", "no-select"), (("eval_return", "average return"),)),

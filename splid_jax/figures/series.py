@@ -29,6 +29,14 @@ class Series:
 MEASURES = ("eval_success", "eval_success_final", "eval_return")
 
 
+def her_settings(config: dict) -> str | None:
+    """Whose settings a HER run's config.json records: "mrl", "Baselines", or None."""
+    from splid_jax.config import TrainConfig
+    from splid_jax.learners.her.config import settings_name
+
+    return settings_name(TrainConfig.from_json(config).learner_config())
+
+
 def load_series(out: str, record: dict) -> list[Series]:
     """Each method's members from its sweeps' directories, grouped by the swept value, over the evaluations
     every member of the group reached."""
@@ -56,6 +64,8 @@ def load_series(out: str, record: dict) -> list[Series]:
             label = METHODS[method].label if not spec.vary else f"{SHORT[spec.vary]} = {value:g}"
             if members[0].config.get("algo") == "gcsl":
                 label += f" ({members[0].config.get('gcsl_relabel')}-state relabelling)"
+            if method == "her" and her_settings(members[0].config):
+                label += f" ({her_settings(members[0].config)})"
             planned = members[0].config.get("iterations")
             if planned is not None and common[-1] < planned:  # a curve that ends early says so in the legend
                 label += f", stopped at {int(stacked['episodes'][0][-1]):,} episodes"

@@ -134,7 +134,7 @@ def test_an_out_that_is_not_utf8_is_one_line_and_exit_2(capsys, tmp_path, monkey
 
 def named(field: str) -> str:
     """How an error names a setting: the flag the user typed, or the positional figure's name."""
-    return "invalid figure=" if field == "figure" else f"invalid --{field} "
+    return "invalid FIGURE " if field == "figure" else f"invalid --{field} "
 
 
 @pytest.mark.parametrize(

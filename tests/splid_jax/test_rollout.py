@@ -90,7 +90,7 @@ def test_rollout_bad_out_fails_before_any_work(tmp_path, capsys, monkeypatch, ou
 
 def test_rollout_of_a_missing_run_is_a_clear_error(tmp_path, capsys):
     assert rollout.main([str(tmp_path / "nothing")]) == 2
-    assert "run_dir" in capsys.readouterr().err
+    assert "invalid RUN_DIR" in capsys.readouterr().err
 
 
 def test_rollout_says_when_the_task_changed_since_training(tmp_path, capsys):

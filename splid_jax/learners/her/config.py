@@ -124,3 +124,17 @@ BASELINES_WORKERS = 8
 # What a run's HER options are read against (its her_defaults): HerConfig's own, or Baselines' for runs recorded
 # while those were HER's defaults.
 DEFAULTS = {"mrl": {}, "baselines": BASELINES}
+
+
+# settings that change how fast the gradient steps run, not what they compute
+_SPEED_ONLY = ("matmul_precision", "compute_dtype")
+
+
+def settings_name(her: HerConfig) -> str | None:
+    """Whose DDPG+HER ``her`` is, as figures name it: "mrl" or "Baselines" (whatever the precision of its
+    products), else None."""
+    plain = dataclasses.replace(her, **{name: getattr(HerConfig(), name) for name in _SPEED_ONLY})
+    for name, settings in (("mrl", {}), ("Baselines", BASELINES)):
+        if plain == HerConfig(**settings):
+            return name
+    return None

@@ -55,7 +55,7 @@ def test_task_without_reference_is_one_line(tmp_path, capsys):
 
 
 def test_directory_without_run_or_checkpoint_is_one_line(tmp_path, capsys):
-    assert "run_dir" in _error(capsys, [str(tmp_path), "--reference"])  # no config.json
+    assert "RUN_DIR" in _error(capsys, [str(tmp_path), "--reference"])  # no config.json
     assert "is not a directory" in _error(capsys, [str(tmp_path / "absent"), "--reference"])
     cfg = TrainConfig(env="reach", run_dir=str(tmp_path))
     (tmp_path / "config.json").write_text(json.dumps(cfg.to_json()))
