@@ -56,15 +56,17 @@ def pytest_unconfigure(config):
     shutil.rmtree(config.splid_cache_home, ignore_errors=True)
 
 
-# Test files that step the same compiled programs (``FetchEpisodes``'s Push programs below, and
-# helpers.solver_program's): one xdist work unit each, so they run on one worker and each program
-# compiles once.
+# Test files that step or lower the same programs (``FetchEpisodes``'s Push programs below, and
+# helpers.solver_program's and helpers.lowered_step's): one xdist work unit each, so they run on one
+# worker and each program compiles, or each step is traced, once.
 SHARED_PROGRAMS = {
     "tests/envs/test_fetch_tasks.py": "fetch-episodes",
     "tests/envs/test_small_cholesky.py": "fetch-episodes",
     "tests/splid_jax/learners/splid/test_select_mjx.py": "fetch-episodes",
-    "tests/envs/test_solver_loops.py": "solver-paths",
-    "tests/envs/test_fused_solver.py": "solver-paths",
+    "tests/envs/test_solver_loops.py": "push-kernels",
+    "tests/envs/test_fused_solver.py": "push-kernels",
+    "tests/envs/test_fused_collision.py": "push-kernels",
+    "tests/envs/test_kernel_batch.py": "push-kernels",
 }
 # The longest units' seconds on a 2-core CPU shared with other work (a full run's --durations, summed per
 # unit; one that ran beside a busy neighbour reads long). They go out first, longest first, so the last
@@ -72,18 +74,17 @@ SHARED_PROGRAMS = {
 # sat idle for the last 90 s). Only the order depends on these.
 UNIT_SECONDS = {
     "fetch-episodes": 155,
+    "push-kernels": 130,
     "tests/splid_jax/runtime/test_multihost.py": 108,
-    "tests/splid_jax/test_train.py": 92,
     "tests/splid_jax/learners/her/test_her.py": 65,
     "tests/splid_jax/learners/test_algos.py": 61,
-    "solver-paths": 57,
-    "tests/envs/test_fused_collision.py": 56,
+    "tests/splid_jax/test_train_processes.py": 60,
     "tests/splid_jax/runtime/test_programs.py": 41,
     "tests/splid_jax/runtime/test_devices.py": 40,
     "tests/splid_jax/reference/test_cli.py": 40,
     "tests/envs/test_reacher.py": 38,
     "tests/splid_jax/test_rollout.py": 37,
-    "tests/envs/test_kernel_batch.py": 32,
+    "tests/splid_jax/test_train.py": 35,
     "tests/splid_jax/runtime/test_loop.py": 32,
     "tests/splid_jax/learners/splid/test_trainer.py": 31,
     "tests/splid_jax/test_figures.py": 27,

@@ -3,7 +3,9 @@ compute fast, and small measures shared by several test files."""
 
 from __future__ import annotations
 
+import contextlib
 import functools
+from unittest import mock
 
 import jax
 import jax.numpy as jnp
@@ -74,29 +76,31 @@ def with_counted_jit(learner, compiler_options=None):
     return learner
 
 
-def _triton_calls(env: GoalEnv, batch: tuple[int, ...], gpu: bool) -> int:
-    """Triton kernel calls in ``env``'s step vmapped over each axis of ``batch`` (envs last), traced and lowered
-    for this CPU or for a GPU (Pallas's Triton lowering needs no device; the caller sets the backend)."""
+@functools.cache
+def lowered_step(env: GoalEnv, batch: tuple[int, ...], gpu: bool) -> str:
+    """The text of ``env``'s step vmapped over each axis of ``batch`` (envs last), traced and lowered for this
+    CPU or, ``gpu``, for a GPU (Pallas's Triton lowering needs no device; the tasks read the backend while
+    traced): once per task, batch and backend for every test reading it (conftest puts their files on one worker)."""
     state = jax.eval_shape(jax.vmap(env.reset), jax.random.split(jax.random.PRNGKey(0), batch[-1]))
     state = jax.tree.map(lambda x: jax.ShapeDtypeStruct(batch[:-1] + x.shape, x.dtype), state)
     actions = jax.ShapeDtypeStruct((*batch, env.action_size), jnp.float32)
     step = env.step
     for _ in batch:
         step = jax.vmap(step)
-    traced = jax.jit(lambda s, a: step(s, a)).trace(state, actions)  # a new function: jit caches traces by function
-    return traced.lower(**({"lowering_platforms": ("cuda",)} if gpu else {})).as_text().count("xla.gpu.triton")
+    backend = mock.patch.object(jax, "default_backend", lambda: "gpu") if gpu else contextlib.nullcontext()
+    with backend:
+        traced = jax.jit(lambda s, a: step(s, a)).trace(state, actions)  # a new function: jit caches traces by function
+        return traced.lower(**({"lowering_platforms": ("cuda",)} if gpu else {})).as_text()
 
 
-def triton_calls_for_gpu(env: GoalEnv, monkeypatch, batch: tuple[int, ...] = (4,)) -> int:
+def triton_calls_for_gpu(env: GoalEnv, batch: tuple[int, ...] = (4,)) -> int:
     """How many Triton kernel calls ``env``'s batched step holds as traced for, and lowered for, a GPU."""
-    with monkeypatch.context() as patched:
-        patched.setattr(jax, "default_backend", lambda: "gpu")
-        return _triton_calls(env, batch, gpu=True)
+    return lowered_step(env, batch, gpu=True).count("xla.gpu.triton")
 
 
-def triton_calls_in_step(env: GoalEnv, monkeypatch, batch: tuple[int, ...] = (4,)) -> tuple[int, int]:
+def triton_calls_in_step(env: GoalEnv, batch: tuple[int, ...] = (4,)) -> tuple[int, int]:
     """How many Triton kernel calls ``env``'s batched step holds as traced on this CPU and as traced for a GPU."""
-    return _triton_calls(env, batch, gpu=False), triton_calls_for_gpu(env, monkeypatch, batch)
+    return lowered_step(env, batch, gpu=False).count("xla.gpu.triton"), triton_calls_for_gpu(env, batch)
 
 
 @functools.cache
@@ -105,7 +109,7 @@ def solver_program(choice: str):
     program and its start. One substep keeps the written-out programs' compiles short; two Newton trips of
     two line-search trips each tell a wrong count of either (about 1e-2); the library's Cholesky, one
     operation where the unrolled one is many, keeps them shorter still. The loops' program is the reference
-    of test_solver_loops and test_fused_solver alike (conftest puts the two files on one worker)."""
+    of test_solver_loops and test_fused_solver alike (conftest puts the files on one worker)."""
     env = envs.make("push", substeps=1, iterations=2, ls_iterations=2, cholesky="library", solver_loops=choice)
     state = jax.jit(lambda key: jax.vmap(env.reset)(jax.random.split(key, 4)))(jax.random.PRNGKey(0))
     actions = jax.random.uniform(jax.random.PRNGKey(1), (6, 4, 4), minval=-1.0, maxval=1.0)

@@ -135,6 +135,6 @@ def test_the_driver_is_given_the_plane_box_and_box_box_groups_alone():
 
 
 @needs_kernels
-def test_push_collides_boxes_in_kernels_on_a_gpu_by_default(monkeypatch):
+def test_push_collides_boxes_in_kernels_on_a_gpu_by_default():
     env = envs.make("push", substeps=1)
-    assert triton_calls_in_step(env, monkeypatch) == (0, 3)  # plane-box and box-box contacts, the constraint solve
+    assert triton_calls_in_step(env) == (0, 3)  # plane-box and box-box contacts, the constraint solve

@@ -13,15 +13,15 @@ from mujoco.mjx._src import solver as mjx_solver
 import envs
 from envs import fused_solver, kernel_batch
 from splid_jax.common.errors import InvalidConfig
-from tests.helpers import needs_kernels, triton_calls_for_gpu
+from tests.helpers import lowered_step, needs_kernels, triton_calls_for_gpu
 
 
 @needs_kernels
-def test_kernels_take_batches_up_to_the_limit_and_xla_larger_ones(monkeypatch):
+def test_kernels_take_batches_up_to_the_limit_and_xla_larger_ones():
     # one env per program loses to batched operations at thousands of envs; a sweep's members (the outer axis)
     # do not count against the limit, the envs of one step (the inner axis) do
     env = envs.make("push", substeps=1, kernel_envs=8)
-    counts = [triton_calls_for_gpu(env, monkeypatch, b) for b in ((9,), (3, 8), (2, 9))]
+    counts = [triton_calls_for_gpu(env, b) for b in ((9,), (3, 8), (2, 9))]
     assert counts == [0, 3, 0]  # at 8 envs Push's two contact groups and the solve
     with pytest.raises(InvalidConfig, match="kernel_envs"):
         envs.make("push", kernel_envs=-1)
@@ -55,22 +55,11 @@ def test_no_limit_keeps_the_kernel_function_itself():
 
 
 @needs_kernels
-def test_every_physics_kernel_takes_the_tasks_warps(monkeypatch):
+def test_every_physics_kernel_takes_the_tasks_warps():
     # one warp per env is the faster kernel at every batch measured (BENCHMARKS.md); 4 is Triton's default
-    from jax.experimental.pallas import triton as pl_triton
-
-    made = []
-    params = pl_triton.CompilerParams
-
-    def recorded(*args, **kwargs):
-        made.append(kwargs.get("num_warps"))
-        return params(*args, **kwargs)
-
-    monkeypatch.setattr(pl_triton, "CompilerParams", recorded)
-    for warps in (None, 4):
-        made.clear()
-        env = envs.make("push", substeps=1) if warps is None else envs.make("push", substeps=1, kernel_warps=warps)
-        assert triton_calls_for_gpu(env, monkeypatch, (8,)) == 3  # the two contact groups and the solve
-        assert made == [1 if warps is None else warps] * 3
+    for warps, options in ((1, {}), (4, {"kernel_warps": 4})):
+        text = lowered_step(envs.make("push", substeps=1, **options), (4,), gpu=True)
+        assert text.count("xla.gpu.triton") == 3  # the two contact groups and the solve
+        assert text.count("num_warps = ") == text.count(f"num_warps = {warps} : i32") == 3
     with pytest.raises(InvalidConfig, match="kernel_warps"):
         envs.make("push", kernel_warps=3)
