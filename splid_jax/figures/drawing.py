@@ -27,7 +27,7 @@ def title(record: dict, series: Sequence[Series]) -> str:
     figure = f"Figures {' and '.join(numbers)}" if len(numbers) > 1 else f"Figure {numbers[0]}"
     return (
         f"{figure}: {spec.title} on {record['env']}, {record['budget_episodes']:,} exploration "
-        f"episodes per {per}\n{n} seed{'s' * (n != '1')} per {per}, mean and standard error; "
+        f"episodes per {per}\n{n} seed{'s' * (seeds != [1])} per {per}, mean and standard error; "
         f"{record['device']}, {record['date']}"
     )
 

@@ -18,7 +18,6 @@ METHODS: dict[str, Method] = {
     "gcsl": Method("GCSL", {"algo": "gcsl"}),
     "pchid": Method("PCHID", {"algo": "pchid"}),
     "her": Method("HER", {"algo": "her"}),  # its legend also names whose settings it ran: mrl's or Baselines'
-
     "es": Method("ES (OpenAI-ES)", {"algo": "es"}),
     "no-select": Method("SPLID without SELECT", {"algo": "splid", "select": False}),
     # the HER of the paper's Figure 3 beside the default one: --methods ...,her,her-baselines

@@ -64,8 +64,9 @@ def load_series(out: str, record: dict) -> list[Series]:
             label = METHODS[method].label if not spec.vary else f"{SHORT[spec.vary]} = {value:g}"
             if members[0].config.get("algo") == "gcsl":
                 label += f" ({members[0].config.get('gcsl_relabel')}-state relabelling)"
-            if method == "her" and her_settings(members[0].config):
-                label += f" ({her_settings(members[0].config)})"
+            whose = her_settings(members[0].config) if method == "her" else None
+            if whose:
+                label += f" ({whose})"
             planned = members[0].config.get("iterations")
             if planned is not None and common[-1] < planned:  # a curve that ends early says so in the legend
                 label += f", stopped at {int(stacked['episodes'][0][-1]):,} episodes"
