@@ -8,7 +8,7 @@ from collections.abc import Sequence
 
 from splid_jax.common.errors import check
 from splid_jax.figures.record import SPEC, check_out, load_record
-from splid_jax.figures.registry import SHORT, SPECS
+from splid_jax.figures.registry import METHODS, SHORT, SPECS
 from splid_jax.runtime import loop
 
 
@@ -68,7 +68,7 @@ def merge(out: str, parts: Sequence[str], figure: str, command: str, replace: bo
                 commands.append({**entry, "methods": kept})
     merged = {
         **first,
-        "methods": sorted(set(methods), key=spec.methods.index),
+        "methods": sorted(set(methods), key=list(METHODS).index),  # the legend order, her-baselines too
         "device": " + ".join(dict.fromkeys(c["device"] for c in commands)),
         "date": " + ".join(dict.fromkeys(c["date"] for c in commands)),
         "command": command,

@@ -138,6 +138,7 @@ def test_merge_joins_subsets_trained_apart_into_one_figure(tmp_path, capsys):
     fake_figure(a, "fig3", {"her": [({"seed": 0, "algo": "her"}, [0.2, 0.4])]})
     fake_figure(b, "fig3", {
         "splid": [({"seed": 0, "algo": "splid"}, [0.5, 0.9])],
+        "her-baselines": [({"seed": 0, "algo": "her", "preset": "paper"}, [0.1, 0.2])],
         "gcsl": [({"seed": 0, "algo": "gcsl", "gcsl_relabel": "final"}, [0.1, 0.1])],
     })  # fmt: skip
     (a / "her" / "s0" / "checkpoints").mkdir()
@@ -145,11 +146,11 @@ def test_merge_joins_subsets_trained_apart_into_one_figure(tmp_path, capsys):
     assert figures.main(["fig3", "--merge", str(a), str(b), "--out", str(out), "--quiet"]) == 0
     assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file() and out not in p.parents} == before
     record = json.loads((out / "figure.json").read_text())
-    assert record["methods"] == ["splid", "gcsl", "her"]  # the figure's legend order
-    assert set(record["runs"]) == {"splid", "gcsl", "her"} and len(record["parts"]) == 2
+    assert record["methods"] == ["splid", "gcsl", "her", "her-baselines"]  # the figure's legend order
+    assert set(record["runs"]) == {"splid", "gcsl", "her", "her-baselines"} and len(record["parts"]) == 2
     assert record["command"].startswith("python -m splid_jax.figures fig3 --merge")
     assert (out / "her" / "s0" / "checkpoints").is_dir()  # --resume continues an unfinished part
-    assert {r["method"] for r in rows(out / "fig3-point.csv")} == {"splid", "gcsl", "her"}
+    assert {r["method"] for r in rows(out / "fig3-point.csv")} == {"splid", "gcsl", "her", "her-baselines"}
 
 
 def test_merge_replaces_a_method_of_an_earlier_merged_figure_and_keeps_each_runs_command(tmp_path, capsys):
