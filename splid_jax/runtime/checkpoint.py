@@ -291,6 +291,27 @@ def restore(
     raise AssertionError("unreachable")
 
 
+def _check_meta(meta: dict, expect_meta: dict | None, where: str) -> None:
+    if expect_meta:
+        diff = _first_meta_diff(meta, json.loads(json.dumps(dict(expect_meta))))
+        if diff is not None:
+            key, have, want = diff
+            raise CheckpointError(f"{where} was saved with {key}={_show(have)} but {key}={_show(want)} is expected")
+
+
+def check_meta(run_dir: str | Path, step: int, expect_meta: dict) -> None:
+    """A resume's settings against its checkpoint's, before anything is compiled: an edited config.json
+    is refused in a moment, not after the compile. A meta that cannot be read is left to ``restore``."""
+    directory = checkpoint_dir(run_dir)
+    try:
+        with _manager(directory, read_only=True) as mngr:
+            meta = mngr.restore(step, args=ocp.args.Composite(**{_META: ocp.args.JsonRestore()}))[_META]
+    except Exception:
+        return
+    if isinstance(meta, dict):
+        _check_meta(meta, expect_meta, f"checkpoint {directory / str(step)}")
+
+
 def _restore(run_dir, like_state, expect_meta, step) -> tuple[int, Any, dict[str, Any]]:
     directory = checkpoint_dir(run_dir)
     if not directory.is_dir():
@@ -320,11 +341,7 @@ def _restore(run_dir, like_state, expect_meta, step) -> tuple[int, Any, dict[str
             raise corrupt(e) from e
         if not isinstance(meta, dict):
             raise corrupt(f"meta is {type(meta).__name__}, not a dict")
-        if expect_meta:
-            diff = _first_meta_diff(meta, json.loads(json.dumps(dict(expect_meta))))
-            if diff is not None:
-                key, have, want = diff
-                raise CheckpointError(f"{where} was saved with {key}={_show(have)} but {key}={_show(want)} is expected")
+        _check_meta(meta, expect_meta, where)
 
         try:
             saved_leaves = _flat(mngr.item_metadata(step)[_STATE].tree)

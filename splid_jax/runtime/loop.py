@@ -138,7 +138,7 @@ class _Loop:
 
     def run(self, resume: bool) -> list[dict]:
         cfg = self.cfg
-        step = multihost.from_first(lambda: check_run_dir(cfg, resume))
+        step = multihost.from_first(lambda: check_run_dir(cfg, resume, self.meta()))
         if resume and step == cfg.iterations:
             self.show(f"{cfg.run_dir}: already complete ({step} iterations); nothing to do")
             return multihost.from_first(

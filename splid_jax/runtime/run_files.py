@@ -114,10 +114,10 @@ def enclosing_run(path: str) -> str | None:
         here = parent
 
 
-def check_run_dir(cfg: TrainConfig, resume: bool) -> int | None:
-    """Refuses a run that would overwrite another, or a resume to fewer iterations than done;
-    returns the step a resume starts from, None where the run stopped before its first whole
-    checkpoint (it then starts again, its records dropped)."""
+def check_run_dir(cfg: TrainConfig, resume: bool, meta: dict | None = None) -> int | None:
+    """Refuses a run that would overwrite another, or a resume to fewer iterations than done or with
+    settings other than its checkpoint's ``meta``; returns the step a resume starts from, None where the
+    run stopped before its first whole checkpoint (it then starts again, its records dropped)."""
     if not resume:
         outer = enclosing_run(cfg.run_dir)
         if outer is not None:
@@ -138,6 +138,8 @@ def check_run_dir(cfg: TrainConfig, resume: bool) -> int | None:
         check_restartable(cfg)
     if step is not None and step > cfg.iterations:
         raise InvalidConfig("iterations", cfg.iterations, f">= {step}, the iterations {cfg.run_dir} has completed")
+    if step is not None and meta is not None:
+        checkpoint.check_meta(cfg.run_dir, step, meta)
     return step
 
 

@@ -154,14 +154,18 @@ def test_nan_stops_the_run_and_keeps_the_last_good_checkpoint(tmp_path):
 
 
 @pytest.mark.slow
-def test_corrupt_and_mismatched_checkpoints_fail_clearly(tmp_path, capsys):
+def test_corrupt_and_mismatched_checkpoints_fail_clearly(tmp_path, capsys, monkeypatch):
+    from splid_jax.runtime import programs
+
     run_dir = tmp_path / "run"
     assert main([*TINY, "--iterations", "5", "--run-dir", str(run_dir), "--quiet"]) == 0
     assert main(["--resume", str(run_dir), "--hidden", "8"]) == 2  # a changed network is not this run
     assert "hidden" in capsys.readouterr().err
     cfg = json.loads((run_dir / "config.json").read_text())
     (run_dir / "config.json").write_text(json.dumps({**cfg, "hidden": [8]}))
-    assert main(["--resume", str(run_dir), "--iterations", "10", "--quiet"]) == 3
+    with monkeypatch.context() as m:  # an edited config.json is refused before anything compiles
+        m.setattr(programs, "compile_all", lambda *a, **k: pytest.fail("compiled before the checkpoint was checked"))
+        assert main(["--resume", str(run_dir), "--iterations", "10", "--quiet"]) == 3
     assert "hidden" in capsys.readouterr().err
     (run_dir / "config.json").write_text(json.dumps(cfg))
     for root, _, files in os.walk(run_dir / "checkpoints"):
