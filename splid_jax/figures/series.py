@@ -34,6 +34,8 @@ def her_settings(config: dict) -> str | None:
     from splid_jax.config import TrainConfig
     from splid_jax.learners.her.config import settings_name
 
+    if config.get("algo") != "her":
+        return None
     return settings_name(TrainConfig.from_json(config).learner_config())
 
 
@@ -45,9 +47,11 @@ def load_series(out: str, record: dict) -> list[Series]:
     for method, ran, sub in sweeps(record):
         for member in ran["members"]:
             try:
-                runs_of[method].append(plot.load_run(os.path.join(out, sub, member["run_dir"])))
+                run = plot.load_run(os.path.join(out, sub, member["run_dir"]))
             except plot.PlotError:
                 continue  # not trained yet, or stopped before its first evaluation
+            # a member without its config.json (results kept lean) is described by the figure's record
+            runs_of[method].append(run if run.config else dataclasses.replace(run, config=member))
     series = []
     for method, runs in runs_of.items():
         groups: dict[Any, list[plot.Run]] = {}

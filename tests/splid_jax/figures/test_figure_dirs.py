@@ -133,6 +133,25 @@ def test_a_stopped_method_keeps_its_seconds_for_the_resumed_total(tmp_path, monk
     assert calls == [False, False]  # nothing was saved, so the second call starts the method afresh
 
 
+def test_members_without_their_config_json_replot_the_same_from_the_figures_record(tmp_path):
+    from splid_jax.config import TrainConfig
+
+    her = {**TrainConfig(env="push", algo="her").to_json(), "seed": 0}
+    fake_figure(tmp_path, "fig3", {
+        "her": [(her, [0.2, 0.4])],
+        "gcsl": [({"seed": 0, "algo": "gcsl", "gcsl_relabel": "final"}, [0.1, 0.3])],
+    })  # fmt: skip
+    def legend():
+        return [(s.label, s.columns["episodes"].tolist()) for s in figures.load_series(str(tmp_path), record)]
+
+    record = figures.load_record(str(tmp_path))
+    before = legend()
+    for path in tmp_path.rglob("config.json"):
+        path.unlink()
+    after = legend()
+    assert after == before and before[0][0].startswith("HER (mrl)") and "final-state" in before[1][0]
+
+
 def test_merge_joins_subsets_trained_apart_into_one_figure(tmp_path, capsys):
     a, b, out = tmp_path / "a", tmp_path / "b", tmp_path / "out"
     fake_figure(a, "fig3", {"her": [({"seed": 0, "algo": "her"}, [0.2, 0.4])]})
