@@ -24,7 +24,6 @@ import math  # noqa: E402
 import os  # noqa: E402
 import sys  # noqa: E402
 
-from splid_jax import plot  # noqa: E402
 from splid_jax.cli import (  # noqa: E402
     Parser,
     add_compile_cache_flag,
@@ -286,6 +285,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{parser.prog}: error: {err}", file=sys.stderr)
         return 3
     if not ns.no_plot and multihost.is_first():
+        from splid_jax import plot  # matplotlib only where a figure is drawn: a --no-plot process starts sooner
+
         out = os.path.join(cfg.run_dir, "grid.png")
         plot.main([m.run_dir for m in lanes] + ["--group", "--out", out, "--overwrite"])  # its own, redrawn
         progress.show(f"figure: {out}", ns.quiet)
