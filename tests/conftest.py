@@ -40,7 +40,11 @@ def pytest_configure(config):
     _faster_cpu_compiles()  # before the first compilation; subprocesses and workers inherit it
     # Before the first compilation: the run neither reads nor writes the user's ~/.cache (JAX's
     # programs, the CLI's default --compile-cache, subprocesses' caches), and starts cold every time.
-    config.splid_cache_home = tempfile.mkdtemp(prefix="splid-jax-tests-")
+    # One directory for the whole run, made by the controlling process: a program that both xdist
+    # workers (or a test's subprocesses) build compiles once.
+    shared = getattr(config, "workerinput", {}).get("splid_cache_home")
+    config.splid_cache_home = shared or tempfile.mkdtemp(prefix="splid-jax-tests-")
+    config.splid_cache_owned = not shared
     os.environ["XDG_CACHE_HOME"] = config.splid_cache_home
     from splid_jax.cli import default_compile_cache
 
@@ -50,10 +54,43 @@ def pytest_configure(config):
     # short, so the second builder of a program loads it instead of compiling it again.
     os.environ["JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS"] = "0"
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0)
+    _atomic_cache_writes()
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node):
+    """Each xdist worker compiles into the controlling process's directory."""
+    node.workerinput["splid_cache_home"] = node.config.splid_cache_home
 
 
 def pytest_unconfigure(config):
-    shutil.rmtree(config.splid_cache_home, ignore_errors=True)
+    if config.splid_cache_owned:
+        shutil.rmtree(config.splid_cache_home, ignore_errors=True)
+
+
+def _atomic_cache_writes() -> None:
+    """JAX writes a cache entry in place, unlocked unless the cache is bounded: the other worker could read
+    a half-written program (JAX then warns and compiles it). Written beside and renamed into place, an
+    entry is whole or absent. Another JAX's cache: as it is."""
+    try:
+        from jax._src import lru_cache
+    except ImportError:
+        return
+    put = getattr(lru_cache.LRUCache, "put", None)
+    if put is None or getattr(put, "atomic", False):
+        return
+
+    def atomic_put(self, key: str, value: bytes) -> None:
+        path = os.path.join(str(self.path), f"{key}{lru_cache._CACHE_SUFFIX}")
+        if self.eviction_enabled or "://" in path or os.path.exists(path):  # bounded, remote, or there already
+            return put(self, key, value)
+        fd, part = tempfile.mkstemp(dir=os.path.dirname(path), prefix=".part-")
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(value)
+        os.replace(part, path)
+
+    atomic_put.atomic = True
+    lru_cache.LRUCache.put = atomic_put
 
 
 # Test files that step or lower the same programs (``FetchEpisodes``'s Push programs below, and
