@@ -113,11 +113,14 @@ def fit(measured: dict) -> dict:
     return out
 
 
-def hand_mjcf(p: dict, timestep: float, damping_scale: float = 1.0) -> str:
-    """Our Slide MJCF (weld law) with the gripper body replaced by the fitted chain; names kept."""
+def hand_mjcf(p: dict, timestep: float, damping_scale: float = 1.0, options: dict | None = None) -> str:
+    """Our Slide MJCF (weld law) with the gripper body replaced by the fitted chain; names kept.
+    ``options``: ``models.mjcf``'s keywords of another Slide variant (e.g. a task's ``model_options()``;
+    ``drive`` must be "weld"), its timestep replaced by ``timestep``."""
     from envs.fetch import models
 
-    base = models.mjcf("slide", timestep, 10, 4, drive="weld")
+    opts = {"iterations": 10, "ls_iterations": 4, **(options or {}), "timestep": timestep, "drive": "weld"}
+    base = models.mjcf("slide", **opts)
     body = re.search(r'    <body name="gripper".*?\n    </body>', base, re.S).group(0)
     inner = body.split("\n", 4)[4].rsplit("\n", 1)[0]  # the site, palm, finger block and tips
     inner = re.sub(r'(<geom name="palm"[^>]*?)mass="[^"]*"', r'\1mass="0.001"', inner, flags=re.S)

@@ -4,7 +4,10 @@ gripper and drive. Beside the MJX and FetchSlide-v4 rows of ``pads_rim_probe.py`
 difference lies in MJX's contacts or in the model (gripper and drive) both of ours share.
 
     PYTHONPATH=. python experiments/results/2026-11-28/slide-pads/analysis/pads_rim_probe_c.py --dirs +x,diag \
-        --offsets 0.015,0.02 [--timestep 0.002 --substeps 20] [--gripper-mass 12.5] [--out OUT.json]
+        --offsets 0.015,0.02 [--timestep 0.002 --substeps 20] [--gripper-mass 12.5] [--table box] [--out OUT.json]
+
+``--table box``: the table's top as the reference's box (C's cylinder-box contact, as FetchSlide-v4's puck stands)
+instead of our plane.
 """
 
 from __future__ import annotations
@@ -12,6 +15,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import sys
 
 import mujoco
@@ -25,7 +29,21 @@ from pads_rim_probe import DIRS, actions, measures, trace  # noqa: E402
 OPTIONS = {"finger": "pads", "finger_table": 1.0, "drive": "weld", "gripper_mass": 22.0}
 
 
-def run_c(u, offset: float, acts: list, timestep: float | None, substeps: int | None, mass: float) -> np.ndarray:
+def box_table(xml: str) -> str:
+    """Our Slide MJCF with the table's plane top replaced by the reference's table box (same pairs)."""
+    from envs.fetch import models
+
+    (tx, ty, tz), (hx, hy, hz), _ = models._SCENES["slide"]
+    head = r'<geom name="table" type="plane" pos="[^"]*" size="[^"]*"'
+    out, n = re.subn(head, f'<geom name="table" type="box" pos="{models._fmt(tx, ty, tz)}" '
+                           f'size="{models._fmt(hx, hy, hz)}"', xml)  # fmt: skip
+    if n != 1:
+        raise ValueError("no plane table top in the MJCF")
+    return out
+
+
+def run_c(u, offset: float, acts: list, timestep: float | None, substeps: int | None, mass: float,
+          table: str = "plane") -> np.ndarray:  # fmt: skip
     """Observation slots 0:6 and 11:13 (grip, puck, puck Euler x and y) per control step, [T + 1, 25]."""
     from envs.fetch import control, models
     from envs.fetch.tasks import Slide
@@ -34,7 +52,8 @@ def run_c(u, offset: float, acts: list, timestep: float | None, substeps: int | 
     opts = task.model_options()
     if timestep:
         opts["timestep"] = timestep
-    m = mujoco.MjModel.from_xml_string(models.mjcf("slide", **opts))
+    xml = models.mjcf("slide", **opts)
+    m = mujoco.MjModel.from_xml_string(box_table(xml) if table == "box" else xml)
     dt = task.timestep * task.substeps
     n_sub = substeps or task.substeps
     g, o = int(m.joint("grip_x").qposadr[0]), int(m.joint("object").qposadr[0])
@@ -73,6 +92,7 @@ def main(argv=None) -> int:
     p.add_argument("--timestep", type=float, default=None, help="default: the task's")
     p.add_argument("--substeps", type=int, default=None, help="default: the task's control step over the timestep")
     p.add_argument("--gripper-mass", type=float, default=OPTIONS["gripper_mass"])
+    p.add_argument("--table", choices=("plane", "box"), default="plane")
     p.add_argument("--trace", action="store_true")
     p.add_argument("--out", default=None)
     args = p.parse_args(argv)
@@ -81,7 +101,7 @@ def main(argv=None) -> int:
         u = np.asarray(DIRS[name])
         acts = actions(u, args.press, args.drag)
         for offset in (float(v) for v in args.offsets.split(",")):
-            x = run_c(u, offset, acts, args.timestep, args.substeps, args.gripper_mass)
+            x = run_c(u, offset, acts, args.timestep, args.substeps, args.gripper_mass, args.table)
             row = {"dir": name, "offset": offset, "c_ours_model": measures(x, u)}
             if args.trace:
                 row["c_ours_model"]["trace"] = trace(x, u)
@@ -89,7 +109,7 @@ def main(argv=None) -> int:
             print(name, offset, json.dumps(row["c_ours_model"]), flush=True)
     if args.out:
         head = {"options": {**OPTIONS, "gripper_mass": args.gripper_mass}, "timestep": args.timestep,
-                "substeps": args.substeps}
+                "substeps": args.substeps, "table": args.table}  # fmt: skip
         with open(args.out, "w") as fh:
             json.dump({**head, "rows": rows}, fh, indent=1)
     return 0
