@@ -139,3 +139,49 @@ def test_edges_against_the_side_as_libccd():
         dist, _, normal = _contacts(poses)
         assert normal[0] @ c_normal[0] > np.cos(np.radians(4.0)), (normal[0], c_normal[0])
         assert np.min(c_dist) - 1e-5 <= np.min(dist) <= np.min(c_dist) + 3e-4
+
+
+def _on_table(tilt, yaw, sink=0.001):
+    """MuJoCo C's contacts (dist, pos) of the puck on a table box, tilted about x by ``tilt`` and turned by ``yaw``,
+    its lowest rim point ``sink`` into the top; and ours (dist, pos) for the same poses."""
+    z = 0.2 + PUCK[1] * np.cos(tilt) + PUCK[0] * np.sin(tilt) - sink
+    xml = f"""<mujoco><option gravity="0 0 0"/><worldbody>
+      <geom name="table" type="box" size="0.25 0.35 0.2" pos="0 0 0" contype="0" conaffinity="0"/>
+      <body pos="0.05 -0.1 {z}"><freejoint/>
+        <geom name="puck" type="cylinder" size="{PUCK[0]} {PUCK[1]}" contype="0" conaffinity="0"/></body>
+    </worldbody><contact><pair geom1="puck" geom2="table" condim="3"/></contact></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    q = np.zeros(4)
+    mujoco.mju_euler2Quat(q, np.array([tilt, 0.0, yaw]), "xyz")
+    d.qpos[3:7] = q
+    mujoco.mj_forward(m, d)
+    c = d.contact[: d.ncon]
+    theirs = np.array([x.dist for x in c]), np.array([x.pos for x in c]).reshape(-1, 3)
+    poses = [(d.geom_xpos[g].copy(), d.geom_xmat[g].reshape(3, 3).copy(), m.geom_size[g].copy()) for g in (1, 0)]
+    dist, pos, frame = _contacts(poses)
+    np.testing.assert_allclose(frame, np.tile([0.0, 0.0, -1.0], (len(dist), 1)), atol=1e-5)
+    return theirs, (dist, pos), d.geom_xpos[1].copy()
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.7])
+def test_puck_on_a_table_box_touches_it_round_the_rim_as_mujoco_c_does(yaw):
+    # flat: four points round the rim at the same depth (C's sit at other angles of the same rim)
+    (cd, cp), (od, op), centre = _on_table(0.0, yaw)
+    assert len(cd) == len(od) == 4
+    np.testing.assert_allclose(od, cd, atol=2e-5)
+    np.testing.assert_allclose(np.linalg.norm((op - centre)[:, :2], axis=1), PUCK[0], atol=1e-4)
+    # tilted 0.06 rad: four points spread over the low side's arc; C's sit on corners of its polygon of the rim, which
+    # turn with the puck, so they match ours in angle and depth only where those corners fall evenly on the arc (yaw 0)
+    (cd, cp), (od, op), centre = _on_table(0.06, yaw)
+    angle = lambda p: np.sort(np.degrees(np.arctan2(p[:, 1] - centre[1], p[:, 0] - centre[0])))  # noqa: E731
+    assert len(od) == 4 and np.all(od <= 1e-8)
+    assert abs(od.min() - cd.min()) < 1.5e-4
+    if yaw == 0.0:
+        np.testing.assert_allclose(angle(op), angle(cp), atol=5.0)
+        np.testing.assert_allclose(np.sort(od), np.sort(cd), atol=1e-4)
+    # tilted 0.1 rad: the lowest rim point alone
+    (cd, cp), (od, op), _ = _on_table(0.1, yaw)
+    assert len(cd) == len(od) == 1
+    np.testing.assert_allclose(od, cd, atol=2e-5)
+    np.testing.assert_allclose(op, cp, atol=5e-4)

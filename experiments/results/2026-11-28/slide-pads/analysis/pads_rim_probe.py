@@ -106,8 +106,10 @@ def main(argv=None) -> int:
     p.add_argument("--dirs", default="+x,diag")
     p.add_argument("--offsets", default="0.015,0.02,0.025")
     p.add_argument("--trace", action="store_true", help="also each step's height, offset and puck tilt")
+    p.add_argument("--table", choices=("plane", "box"), default="plane", help="our table (the reference: box)")
     p.add_argument("--out", default=None)
     args = p.parse_args(argv)
+    options = OPTIONS + (",table=box" if args.table == "box" else "")
     import jax
 
     import envs
@@ -115,7 +117,7 @@ def main(argv=None) -> int:
     from splid_jax.reference.extra import import_reference
 
     import_reference()
-    env = envs.make("slide", **parse_overrides(OPTIONS))
+    env = envs.make("slide", **parse_overrides(options))
     step = jax.jit(env.step)
     rows = []
     for name in args.dirs.split(","):
@@ -132,7 +134,7 @@ def main(argv=None) -> int:
             print(name, offset, " | ".join(f"{s}: {json.dumps(row[s])}" for s in ("ours", "fetch")), flush=True)
     if args.out:
         with open(args.out, "w") as fh:
-            json.dump({"env_options": OPTIONS, "press": args.press, "drag": args.drag, "rows": rows}, fh, indent=1)
+            json.dump({"env_options": options, "press": args.press, "drag": args.drag, "rows": rows}, fh, indent=1)
     return 0
 
 
