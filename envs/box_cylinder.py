@@ -17,9 +17,7 @@ axis selects the cap, within ``SNAP`` of horizontal the side wall, so a box face
 rounding in its tilt) keeps a face contact rather than a point, pushing along the box face's normal. The contact
 points then follow the feature of the cylinder that the normal selects: on a cap, the corners of the box's face
 that faces it, clipped to the disc along the face's edges, each at its own depth; on the side wall, the wall's
-vertical segment clipped to the box's extent along it (two points); on the rim, the rim point (one). A box face that
-holds the whole disc (a box table under the puck, Slide's ``table="box"``) touches the cap's rim instead, at up to
-four points as MuJoCo C's multi-point contact gives there (``_cap_on_face``).
+vertical segment clipped to the box's extent along it (two points); on the rim, the rim point (one).
 """
 
 from __future__ import annotations
@@ -30,7 +28,6 @@ import numpy as np
 
 NCON = 4
 UNUSED = 1.0  # dist of a contact slot that holds no contact
-TILT_ONE_POINT = 0.0885  # rad: a puck tilted further on a table touches it at one point (MuJoCo C's, 0.0875 to 0.09)
 SNAP = 0.1  # rad: a normal this close to the cylinder's axis is the cap's, this close to horizontal the wall's
 _SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], np.float64)  # corners
 _EDGES = np.array([(i, j) for i in range(8) for j in range(i + 1, 8) if np.abs(_SIGNS[i] - _SIGNS[j]).sum() == 2])
@@ -112,35 +109,6 @@ def _make_frame(n):
     return mjx_math.make_frame(n)
 
 
-def _cap_on_face(center, axes, size, face_axis, along, radius, half):
-    """(dist [4], pos [4, 3], normal [3]) of the cap nearest a box face wide enough to hold the whole disc (a puck on
-    a table): four points spread evenly over the arc of the rim below the face, as MuJoCo C's multi-point contact
-    places them (all round the rim when the puck stands flat, bunched at the low side once it tilts), each at its
-    own depth; past ``TILT_ONE_POINT`` the rim's lowest point alone, as there; in the cylinder's frame."""
-    w = -axes[:, face_axis] * jnp.where(along[face_axis] > 0, 1.0, -1.0)  # the face's outward normal
-    cap_z = -jnp.where(w[2] >= 0, 1.0, -1.0) * half
-    b = radius * jnp.linalg.norm(w[:2])
-    a = w[2] * cap_z - jnp.dot(w, center) - size[face_axis]  # the rim's mean height above the face
-    theta0 = jnp.arctan2(-w[1], -w[0])  # the rim's lowest point
-    cos_arc = jnp.clip(a / jnp.where(b > 1e-9, b, 1.0), -1.0, 1.0)
-    arc = jnp.where(b > 1e-9, jnp.arccos(cos_arc), jnp.where(a < 0, np.pi, 0.0))
-    arc = jnp.minimum(arc, 0.75 * np.pi)  # a full circle: four points a quarter turn apart
-    single = jnp.abs(w[2]) < np.cos(TILT_ONE_POINT)
-    theta = theta0 + jnp.where(single, 0.0, arc) * jnp.array([-1.0, -1.0 / 3.0, 1.0 / 3.0, 1.0])
-    theta = jnp.where(single & (jnp.arange(4) == 0), theta0, theta)
-    rim = jnp.stack([radius * jnp.cos(theta), radius * jnp.sin(theta), jnp.full_like(theta, cap_z)], axis=1)
-    dist = a + radius * (w[0] * jnp.cos(theta) + w[1] * jnp.sin(theta))
-    dist = jnp.where(single & (jnp.arange(4) > 0), UNUSED, dist)
-    return dist, rim - 0.5 * dist[:, None] * w, -w
-
-
-def _face_holds_disc(cyl_pos, box_pos, box_mat, box_size, face_axis, radius):
-    """Whether the box's face across ``face_axis`` is wide enough round the cylinder's axis to hold its whole disc."""
-    c = box_mat.T @ (cyl_pos - box_pos)
-    other = jnp.arange(3) != face_axis
-    return jnp.all(jnp.where(other, jnp.abs(c) + radius <= box_size, True))
-
-
 def box_cylinder(cyl_pos, cyl_mat, cyl_size, box_pos, box_mat, box_size):
     """(dist [4], pos [4, 3], frame [4, 3, 3]) of a cylinder (geom 1: pos [3], mat [3, 3], size: radius, half
     height) against a box (geom 2: pos, mat, half sizes): normals point from the cylinder to the box, a contact's
@@ -188,10 +156,6 @@ def box_cylinder(cyl_pos, cyl_mat, cyl_size, box_pos, box_mat, box_size):
     # slightly tilted puck then presses it down, not sideways
     face_n = axes[:, face_axis] * jnp.where(along[face_axis] > 0, 1.0, -1.0)
     n = jnp.where(is_cap & (jnp.abs(face_n[2]) >= np.cos(SNAP)), face_n, n)
-    # a face that holds the whole disc (a table under the puck; never a finger pad): the rim's points below it
-    holds = (jnp.dot(n, face_n) >= 0.999) & _face_holds_disc(cyl_pos, box_pos, box_mat, box_size, face_axis, radius)
-    t_dist, t_pos, t_n = _cap_on_face(center, axes, box_size, face_axis, along, radius, half)
-    dist, pos, n = jnp.where(holds, t_dist, dist), jnp.where(holds, t_pos, pos), jnp.where(holds, t_n, n)
     world_n = cyl_mat @ n
     world_pos = cyl_pos + pos @ cyl_mat.T
     return dist, world_pos, jnp.broadcast_to(_make_frame(world_n), (NCON, 3, 3))

@@ -111,8 +111,8 @@ TABLES = ("plane", "box")
 
 
 def tables_for(kind: str) -> tuple[str, ...]:
-    """The table shapes task ``kind`` can use; Slide's puck meets a box table through ``envs/box_cylinder.py``."""
-    return TABLES
+    """The table shapes task ``kind`` can use: MJX collides Slide's cylinder puck with a plane only."""
+    return ("plane",) if kind == "slide" else TABLES
 
 
 def fingers_for(kind: str) -> tuple[str, ...]:
