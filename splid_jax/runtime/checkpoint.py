@@ -291,6 +291,10 @@ def restore(
     raise AssertionError("unreachable")
 
 
+def _read_meta(mngr: ocp.CheckpointManager, step: int) -> Any:
+    return mngr.restore(step, args=ocp.args.Composite(**{_META: ocp.args.JsonRestore()}))[_META]
+
+
 def _check_meta(meta: dict, expect_meta: dict | None, where: str) -> None:
     if expect_meta:
         diff = _first_meta_diff(meta, json.loads(json.dumps(dict(expect_meta))))
@@ -305,7 +309,7 @@ def check_meta(run_dir: str | Path, step: int, expect_meta: dict) -> None:
     directory = checkpoint_dir(run_dir)
     try:
         with _manager(directory, read_only=True) as mngr:
-            meta = mngr.restore(step, args=ocp.args.Composite(**{_META: ocp.args.JsonRestore()}))[_META]
+            meta = _read_meta(mngr, step)
     except Exception:
         return
     if isinstance(meta, dict):
@@ -336,7 +340,7 @@ def _restore(run_dir, like_state, expect_meta, step) -> tuple[int, Any, dict[str
             return CheckpointError(f"{where} is corrupt or unreadable ({reason}){hint}")
 
         try:
-            meta = mngr.restore(step, args=ocp.args.Composite(**{_META: ocp.args.JsonRestore()}))[_META]
+            meta = _read_meta(mngr, step)
         except Exception as e:
             raise corrupt(e) from e
         if not isinstance(meta, dict):

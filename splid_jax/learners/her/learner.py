@@ -9,6 +9,8 @@ goal normaliser, so evaluation, rollouts and checkpoints read it as they read SP
 
 from __future__ import annotations
 
+import contextlib
+
 import jax
 import jax.numpy as jnp
 import optax
@@ -243,11 +245,9 @@ class HER(Chunked):
         one pass before the steps; otherwise the targets move every ``target_every`` steps; where that
         divides the step count, each block of ``target_every`` steps takes its targets in one pass, since
         the target networks hold still over it."""
-        if self.her.matmul_precision == "default":
+        precision = self.her.matmul_precision
+        with contextlib.nullcontext() if precision == "default" else jax.default_matmul_precision(precision):
             stepped, losses = self._updates(hs, key)
-        else:
-            with jax.default_matmul_precision(self.her.matmul_precision):
-                stepped, losses = self._updates(hs, key)
         critic, critic_opt, actor, actor_opt = _pick(self.warm(hs.buffer), self._learnt(stepped), self._learnt(hs))
         stepped = stepped.replace(
             critic=critic, critic_opt=critic_opt, policy=stepped.policy.replace(params=actor), actor_opt=actor_opt
