@@ -4,22 +4,24 @@ preset's; a run's config.json records the resolved values, so a preset changed l
 recorded run as it ran.
 
 ``tuned`` adds to Algorithm 2 what learned best where it was compared, each chosen on tuning seeds and
-reported on fresh ones (BENCHMARKS.md, the task's section; experiments/NOTES.md, "Task defaults"):
+reported on fresh ones; the "why" is an experiments/NOTES.md section ("Task defaults" lists them):
 
-| addition (settings) | tasks | why (BENCHMARKS.md section) |
+| addition (settings) | tasks | why (NOTES.md section) |
 |---|---|---|
-| held goals (relabel hold), cloned with the zero action (stop) | Push stop; Slide, P&P hold | "Final-step success" |
-| H falling 12 -> 8 with the noise (horizon, horizon_end) | Push | "Push" |
-| noise annealed to sigma_end x sigma (sigma_end, sigma_anneal) | Push, Slide, P&P | "Push" |
-| a Polyak-averaged acting policy (policy_ema) | Push, Slide, P&P | "Push" |
-| a cloning window widening to the buffer (buffer_window, _grow) | Push | "Push" |
-| exploring, evaluated steered at subgoals (*_subgoal_reach) | Push, Slide, P&P | "Subgoals at evaluation" |
-| relative goal, raw inputs, Adam 5e-4 (relative_goal, ...) | Fetch tasks | "Push" |
+| held goals (relabel hold), cloned with the zero action | Push stop; Slide, P&P hold | "Final-step success on Push" |
+| H falling 12 -> 8 with the noise (horizon, horizon_end) | Push | "Push: the default's arms" |
+| noise annealed to sigma_end x sigma (sigma_end, sigma_anneal) | Push, Slide, P&P | "Push: the default's arms" |
+| a Polyak-averaged acting policy (policy_ema) | Push, Slide, P&P | "Push: the default's arms" |
+| a cloning window widening to the buffer (buffer_window, _grow) | Push | "Push: the default's arms" |
+| steered at subgoals (*_subgoal_reach) | Push, Slide, P&P | "PickAndPlace: subgoals at evaluation" |
+| relative goal, raw inputs, Adam 5e-4 (relative_goal, ...) | Fetch tasks | "Push: the default's arms" |
+| half the envs per iteration, twice the iterations (num_envs 256) | P&P | "Envs per iteration against iterations" |
 
 Held goals keep a reached goal (Algorithm 2 never stores one, so the policy pushes through it); a falling
 H learns early and judges the final approach; less noise late and an averaged acting policy make the
 policy precise; the widening window clones the newest pairs first and keeps the learning phase's later;
-subgoals keep far goals within those a policy is taught.
+subgoals keep far goals within those a policy is taught; PickAndPlace's smaller iterations clone and select
+with a newer policy twice as often for the same episodes.
 
 ``paper`` is Algorithm 2 as the paper states it; where the paper is silent, the authors' released code
 (decisionforce/ESPD); every value's source is in ``PAPER_SOURCES``. HER's ``tuned`` is spitis/mrl's
@@ -70,7 +72,8 @@ TUNED: dict[str, dict[str, Any]] = {
     },
     "slide": {**_HELD_STEERED, "iterations": 70, "buffer_size": 50_000},
     "pick_and_place": {
-        **_HELD_STEERED, "env_options": "grasped_starts=0.5", "iterations": 40, "buffer_size": 100_000,
+        **_HELD_STEERED, "env_options": "grasped_starts=0.5", "num_envs": 256, "iterations": 80, "sigma_anneal": 100,
+        "buffer_size": 100_000,
     },
     "reacher": {**_POINT, "iterations": 40},
     "sawyer_door": {**_POINT, "iterations": 40},

@@ -91,3 +91,54 @@ arm 1 reuse400 $P --bc-steps 400 --vary bc_reuse=40,80 --vary learning_rate=5e-4
 wait
 cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/e1.tgz -T - times.txt gpus.txt
 cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
+# Call 2 (2 GPUs): SPLID PickAndPlace arms on tuning seeds 1000-1004 to 15,360 episodes: envs per iteration against
+# iterations (the noise's annealing scaled with them), and Push arms over the starting noise, under MPS.
+export NCCL_NVLS_ENABLE=0 PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=$PWD:/tmp/site
+W=/tmp/e2; mkdir -p $W/arms; T0=$(date +%s)
+nvidia-cuda-mps-control -d 2>/dev/null && echo mps >> $W/times.txt
+C="--checkpoint-every 0 --compile-cache= --no-plot --seeds 5 --seed 1000"
+arm() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$g timeout -k 10 $(( 540 - ($(date +%s) - T0) )) python3 -m splid_jax.sweep $C --run-dir $W/arms/$n "$@" > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+P="--env pick_and_place"
+arm 0 pnp512 $P --iterations 30 &
+arm 0 pnp256 $P --num-envs 256 --iterations 60 --sigma-anneal 100 &
+arm 0 push-sigmas --env push --iterations 80 --sigmas 0.5,0.7 &
+arm 1 pnp128 $P --num-envs 128 --iterations 120 --sigma-anneal 200 &
+arm 1 pnp128_bc100 $P --num-envs 128 --iterations 120 --sigma-anneal 200 --bc-steps 100 &
+wait
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/e2.tgz -T - times.txt
+cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
+# Call 3 (2 GPUs): PickAndPlace on fresh seeds 7000-7004 (HER (mrl)'s) and 0-4 (Figure 3's): 256 envs x 60 iterations and
+# 128 x 120 (100 BC steps) beside the default's 512 x 30, to 15,360 episodes, under MPS.
+export NCCL_NVLS_ENABLE=0 PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=$PWD:/tmp/site
+W=/tmp/e3; mkdir -p $W/arms; T0=$(date +%s)
+nvidia-cuda-mps-control -d 2>/dev/null && echo mps >> $W/times.txt
+C="--checkpoint-every 0 --compile-cache= --no-plot --seeds 5 "
+arm() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$g timeout -k 10 $(( 540 - ($(date +%s) - T0) )) python3 -m splid_jax.sweep $C --run-dir $W/arms/$n "$@" > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+P="--env pick_and_place"
+P="--env pick_and_place"
+arm 0 pnp256_7000 $P --seed 7000 --num-envs 256 --iterations 60 --sigma-anneal 100 &
+arm 0 pnp256_0 $P --seed 0 --num-envs 256 --iterations 60 --sigma-anneal 100 &
+arm 1 pnp128bc100_7000 $P --seed 7000 --num-envs 128 --iterations 120 --sigma-anneal 200 --bc-steps 100 &
+arm 1 pnp512_7000 $P --seed 7000 --iterations 30 &
+wait
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/e3.tgz -T - times.txt
+cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
+# Call 4 (2 GPUs): Slide arms on tuning seeds 1000-1004 to 15,360 episodes: envs per iteration against iterations.
+export NCCL_NVLS_ENABLE=0 PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=$PWD:/tmp/site
+W=/tmp/e4; mkdir -p $W/arms; T0=$(date +%s)
+nvidia-cuda-mps-control -d 2>/dev/null && echo mps >> $W/times.txt
+C="--checkpoint-every 0 --compile-cache= --no-plot --seeds 5 --seed 1000"
+arm() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$g timeout -k 10 $(( 380 - ($(date +%s) - T0) )) python3 -m splid_jax.sweep $C --run-dir $W/arms/$n "$@" > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+P="--env slide"
+arm 0 slide512 $P --iterations 30 &
+arm 0 slide256 $P --num-envs 256 --iterations 60 --sigma-anneal 100 &
+arm 1 slide128 $P --num-envs 128 --iterations 120 --sigma-anneal 200 &
+wait
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/e4.tgz -T - times.txt
+cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
