@@ -17,6 +17,8 @@ import jax.extend.core
 import jax.numpy as jnp
 import pytest
 
+from tests import compile_cache
+
 pytest_plugins = ("tests.hang_watchdog",)  # a test that hangs ends its worker, with every stack logged
 
 # XLA:CPU's fusion emitters cost about a third of each compile here, and the suite is mostly
@@ -54,7 +56,7 @@ def pytest_configure(config):
     # short, so the second builder of a program loads it instead of compiling it again.
     os.environ["JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS"] = "0"
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0)
-    _atomic_cache_writes()
+    compile_cache.atomic_writes()
 
 
 @pytest.hookimpl(optionalhook=True)
@@ -66,31 +68,6 @@ def pytest_configure_node(node):
 def pytest_unconfigure(config):
     if config.splid_cache_owned:
         shutil.rmtree(config.splid_cache_home, ignore_errors=True)
-
-
-def _atomic_cache_writes() -> None:
-    """JAX writes a cache entry in place, unlocked unless the cache is bounded: the other worker could read
-    a half-written program (JAX then warns and compiles it). Written beside and renamed into place, an
-    entry is whole or absent. Another JAX's cache: as it is."""
-    try:
-        from jax._src import lru_cache
-    except ImportError:
-        return
-    put = getattr(lru_cache.LRUCache, "put", None)
-    if put is None or getattr(put, "atomic", False):
-        return
-
-    def atomic_put(self, key: str, value: bytes) -> None:
-        path = os.path.join(str(self.path), f"{key}{lru_cache._CACHE_SUFFIX}")
-        if self.eviction_enabled or "://" in path or os.path.exists(path):  # bounded, remote, or there already
-            return put(self, key, value)
-        fd, part = tempfile.mkstemp(dir=os.path.dirname(path), prefix=".part-")
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(value)
-        os.replace(part, path)
-
-    atomic_put.atomic = True
-    lru_cache.LRUCache.put = atomic_put
 
 
 # Test files that step or lower the same programs (``FetchEpisodes``'s Push programs below, and
@@ -110,27 +87,27 @@ SHARED_PROGRAMS = {
 # units handed out are short and the two workers end together (in the order of collection, a worker once
 # sat idle for the last 90 s). Only the order depends on these.
 UNIT_SECONDS = {
-    "fetch-episodes": 155,
-    "push-kernels": 130,
-    "tests/splid_jax/runtime/test_multihost.py": 108,
-    "tests/splid_jax/learners/her/test_her.py": 65,
-    "tests/splid_jax/learners/test_algos.py": 61,
-    "tests/splid_jax/test_train_processes.py": 60,
-    "tests/splid_jax/runtime/test_programs.py": 41,
-    "tests/splid_jax/runtime/test_devices.py": 40,
-    "tests/splid_jax/reference/test_cli.py": 40,
-    "tests/envs/test_reacher.py": 38,
-    "tests/splid_jax/test_rollout.py": 37,
-    "tests/splid_jax/test_train.py": 35,
-    "tests/splid_jax/runtime/test_loop.py": 32,
-    "tests/splid_jax/learners/splid/test_trainer.py": 31,
-    "tests/splid_jax/test_figures.py": 27,
-    "tests/splid_jax/runtime/test_run_files.py": 25,
-    "tests/splid_jax/learners/test_es.py": 25,
-    "tests/splid_jax/test_sweep.py": 21,
-    "tests/envs/test_slide_fingers.py": 14,
-    "tests/splid_jax/runtime/test_checkpoint.py": 13,
-    "tests/test_hang_watchdog.py": 11,
+    "push-kernels": 107,
+    "fetch-episodes": 74,
+    "tests/splid_jax/runtime/test_multihost.py": 43,
+    "tests/splid_jax/learners/her/test_her.py": 41,
+    "tests/splid_jax/test_train_processes.py": 33,
+    "tests/splid_jax/learners/splid/test_trainer.py": 21,
+    "tests/splid_jax/runtime/test_run_files.py": 20,
+    "tests/splid_jax/learners/test_algos.py": 19,
+    "tests/splid_jax/reference/test_cli.py": 18,
+    "tests/splid_jax/test_train.py": 18,
+    "tests/splid_jax/runtime/test_devices.py": 17,
+    "tests/splid_jax/test_rollout.py": 16,
+    "tests/splid_jax/runtime/test_programs.py": 15,
+    "tests/splid_jax/test_figures.py": 15,
+    "tests/splid_jax/test_sweep.py": 14,
+    "tests/envs/test_reacher.py": 12,
+    "tests/splid_jax/runtime/test_loop.py": 11,
+    "tests/envs/test_slide_fingers.py": 10,
+    "tests/splid_jax/learners/test_gcsl.py": 8,
+    "tests/splid_jax/learners/test_es.py": 8,
+    "tests/test_hang_watchdog.py": 6,
 }
 
 

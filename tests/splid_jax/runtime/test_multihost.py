@@ -11,6 +11,7 @@ import socket
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import jax
 import pytest
@@ -19,12 +20,14 @@ from splid_jax import sweep, train
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.runtime import devices, multihost
 
-# the smallest Fetch sweep: chunks of two iterations of 4-step episodes
+# the smallest Fetch sweep: chunks of two iterations of 4-step episodes, into a buffer of 64 pairs (Reach's own
+# million would be the state gathered for each checkpoint and sent to process 1 on resume)
 TINY = ["--env", "reach", "--env-options", "max_episode_steps=4", "--num-envs", "2", "--eval-episodes", "2",
-        "--eval-every", "2", "--bc-steps", "2", "--batch-size", "8", "--hidden", "8", "--seeds", "2",
-        "--horizons", "2", "--no-plot"]  # fmt: skip
+        "--eval-every", "2", "--bc-steps", "2", "--batch-size", "8", "--hidden", "8", "--buffer-size", "64",
+        "--seeds", "2", "--horizons", "2", "--no-plot"]  # fmt: skip
 VOLATILE = {"wall_s", "steps_per_s"}
 MEMBERS = ("sigma1-H2-s0", "sigma1-H2-s1")
+REPO = Path(__file__).resolve().parents[3]
 
 
 def free_port() -> int:
@@ -34,14 +37,16 @@ def free_port() -> int:
 
 
 def launch(root, tag: str, args_of) -> list[subprocess.Popen]:
-    """Processes 0 and 1 of one sweep; ``args_of(i)`` gives process i's own arguments."""
+    """Processes 0 and 1 of one sweep (``python -m splid_jax.sweep``, both writing the suite's compile cache,
+    so the resumed pair compiles nothing); ``args_of(i)`` gives process i's own arguments."""
     port = free_port()
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(REPO), os.environ.get("PYTHONPATH")]))}
     procs = []
     for i in range(2):
         out = open(root / f"{tag}-{i}.out", "w")
-        cmd = [sys.executable, "-m", "splid_jax.sweep", *args_of(i), "--coordinator", f"127.0.0.1:{port}",
-               "--num-processes", "2", "--process-id", str(i)]  # fmt: skip
-        procs.append(subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, text=True))
+        cmd = [sys.executable, "-m", "tests.compile_cache", "splid_jax.sweep", *args_of(i),
+               "--coordinator", f"127.0.0.1:{port}", "--num-processes", "2", "--process-id", str(i)]  # fmt: skip
+        procs.append(subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, text=True, env=env))
     return procs
 
 
