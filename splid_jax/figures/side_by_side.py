@@ -92,7 +92,8 @@ def placed(record: dict, gpus: list[str]) -> tuple[dict, list[str | None]]:
     seeds = {m: 0 for m in record["methods"]}
     for method, ran, _ in found:
         seeds[method] += len(ran["members"])
-    where = spreading.assign([spreading.cost(m, len(ran["members"]), seeds[m]) for m, ran, _ in found], len(gpus))
+    costs = [spreading.cost(m, len(ran["members"]), seeds[m], ran.get("config")) for m, ran, _ in found]
+    where = spreading.assign(costs, len(gpus))
     for (_, ran, _), g in zip(found, where, strict=True):
         ran["gpu"] = gpus[g]
     return record, [gpus[g] for g in where]

@@ -37,3 +37,13 @@ def test_the_heaviest_process_goes_first_to_the_least_loaded_gpu():
     loads = [sum(c for c, g in zip(costs, where, strict=True) if g == k) for k in (0, 1)]
     assert max(loads) < sum(costs) * 0.6  # balanced, where all on one GPU would take the whole sum
     assert sorted(spreading.assign(costs, 6)) == list(range(6))  # one process a GPU
+
+
+def test_mrls_her_has_a_gpu_to_itself_and_baselines_her_shares_one():
+    costs = [spreading.cost(m, 5, 5, {"preset": "tuned"}) for m in FIG3]
+    where = spreading.assign(costs, 2)
+    assert [m for m, g in zip(FIG3, where, strict=True) if g == where[FIG3.index("her")]] == ["her"]
+    paper = [spreading.cost(m, 5, 5, {"preset": "paper"}) for m in FIG3]
+    assert paper[FIG3.index("her")] == spreading.cost("her-baselines", 5, 5) < costs[FIG3.index("her")]
+    where = spreading.assign(paper, 2)
+    assert sum(g == where[FIG3.index("her")] for g in where) > 1  # at Baselines' settings HER shares its GPU
