@@ -16,13 +16,19 @@ from splid_jax.common.errors import InvalidConfig
 from tests.helpers import lowered_step, needs_kernels, triton_calls_for_gpu
 
 
+# the kernels' limit and warps, lowered once for both tests below; the library's Cholesky (which no kernel
+# calls) keeps the traces short
+def _limited():
+    return envs.make("push", substeps=1, kernel_envs=8, kernel_warps=4, cholesky="library")
+
+
 @needs_kernels
 def test_kernels_take_batches_up_to_the_limit_and_xla_larger_ones():
     # one env per program loses to batched operations at thousands of envs; a sweep's members (the outer axis)
-    # do not count against the limit, the envs of one step (the inner axis) do
-    env = envs.make("push", substeps=1, kernel_envs=8)
-    counts = [triton_calls_for_gpu(env, b) for b in ((9,), (3, 8), (2, 9))]
-    assert counts == [0, 3, 0]  # at 8 envs Push's two contact groups and the solve
+    # do not count against the limit, the envs of one step (the inner axis) do (one vmap alone over the limit:
+    # test_no_limit_keeps_the_kernel_function_itself)
+    counts = [triton_calls_for_gpu(_limited(), b) for b in ((3, 8), (2, 9))]
+    assert counts == [3, 0]  # at 8 envs Push's two contact groups and the solve
     with pytest.raises(InvalidConfig, match="kernel_envs"):
         envs.make("push", kernel_envs=-1)
 
@@ -52,13 +58,15 @@ def test_no_limit_keeps_the_kernel_function_itself():
     np.testing.assert_array_equal(jax.vmap(limited)(jnp.ones(2)), [2.0, 2.0])
     np.testing.assert_array_equal(jax.vmap(limited)(jnp.ones(3)), [0.0, 0.0, 0.0])
     np.testing.assert_array_equal(jax.vmap(jax.vmap(limited))(jnp.ones((3, 2))), np.full((3, 2), 2.0))
+    np.testing.assert_array_equal(jax.vmap(jax.vmap(limited))(jnp.ones((2, 3))), np.zeros((2, 3)))
 
 
 @needs_kernels
 def test_every_physics_kernel_takes_the_tasks_warps():
     # one warp per env is the faster kernel at every batch measured (BENCHMARKS.md); 4 is Triton's default
-    for warps, options in ((1, {}), (4, {"kernel_warps": 4})):
-        text = lowered_step(envs.make("push", substeps=1, **options), (4,), gpu=True)
+    # at the default's, as test_fused_collision lowers Push's step, and at 4, as the test above does
+    for warps, env, batch in ((1, envs.make("push", substeps=1), (4,)), (4, _limited(), (3, 8))):
+        text = lowered_step(env, batch, gpu=True)
         assert text.count("xla.gpu.triton") == 3  # the two contact groups and the solve
         assert text.count("num_warps = ") == text.count(f"num_warps = {warps} : i32") == 3
     with pytest.raises(InvalidConfig, match="kernel_warps"):
