@@ -126,10 +126,11 @@ def groups(kernel: bool = False, max_envs: int = 0, num_warps: int | None = None
 
 def contacts(task, physics, fused: bool):
     """(dist, pos, frame) of MJX's contacts for one env of a Fetch ``task`` at its ``physics`` state, collided by
-    MJX's functions or, if ``fused``, by this module's: what the parity checks compare."""
+    MJX's functions or, if ``fused``, by this module's: what the parity checks compare. The contacts need the
+    bodies' poses alone: kinematics and collision, not the whole forward step."""
     from mujoco import mjx
 
     data = data_with(make_data(task.mjx_model), physics)
     with patched_mjx(collide=groups() if fused else None):
-        c = mjx.forward(task.mjx_model, data)._impl.contact
+        c = mjx.collision(task.mjx_model, mjx.kinematics(task.mjx_model, data))._impl.contact
     return c.dist, c.pos, c.frame

@@ -21,6 +21,7 @@ def test_fused_solve_follows_mjx_path():
     np.testing.assert_allclose(fused, loops, atol=1e-5)
 
 
+@functools.partial(jax.jit, static_argnames=("nefc", "nv"))  # one program, not an operation at a time
 def _problem(key, nefc=40, nv=9):
     """A random solve with a third of the rows pushing against their constraint (negative aref)."""
     k = jax.random.split(key, 6)
