@@ -87,7 +87,7 @@ SHARED_PROGRAMS = {
 # units handed out are short and the two workers end together (in the order of collection, a worker once
 # sat idle for the last 90 s). Only the order depends on these.
 UNIT_SECONDS = {
-    "push-kernels": 107,
+    "push-kernels": 80,
     "fetch-episodes": 74,
     "tests/splid_jax/runtime/test_multihost.py": 43,
     "tests/splid_jax/learners/her/test_her.py": 41,
