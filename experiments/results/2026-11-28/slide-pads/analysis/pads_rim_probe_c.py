@@ -42,6 +42,31 @@ def box_table(xml: str) -> str:
     return out
 
 
+def c_start(m: mujoco.MjModel, o: int, u, offset: float) -> tuple:
+    """MuJoCo C's data with the puck at rest 0.04 + ``offset`` m from the grip home along ``u``; with the grip home
+    and the workspace's bounds: ``(data, home, lo, hi)``."""
+    from envs.fetch import models
+
+    home = np.asarray(models._SCENES["slide"][2])
+    lo, hi = models.workspace_box("slide", OPTIONS["finger_table"])
+    d = mujoco.MjData(m)
+    xy = home[:2] + (0.04 + offset) * np.asarray(u)
+    d.qpos[o : o + 7] = [*xy, models.rest_height(m, o), 1, 0, 0, 0]
+    mujoco.mj_forward(m, d)
+    return d, home, lo, hi
+
+
+def c_observation(m: mujoco.MjModel, d: mujoco.MjData, site: int, o: int) -> np.ndarray:
+    """Observation slots 0:6 and 11:13 (grip, puck, puck Euler x and y) of MuJoCo C's state, the rest 0."""
+    mujoco.mj_kinematics(m, d)
+    obs = np.zeros(25)
+    obs[0:3], obs[3:6] = d.site_xpos[site], d.qpos[o : o + 3]
+    w, x, y, z = d.qpos[o + 3 : o + 7]
+    obs[11] = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    obs[12] = np.arcsin(np.clip(2 * (w * y - z * x), -1, 1))
+    return obs
+
+
 def run_c(u, offset: float, acts: list, timestep: float | None, substeps: int | None, mass: float,
           table: str = "plane") -> np.ndarray:  # fmt: skip
     """Observation slots 0:6 and 11:13 (grip, puck, puck Euler x and y) per control step, [T + 1, 25]."""
@@ -58,21 +83,10 @@ def run_c(u, offset: float, acts: list, timestep: float | None, substeps: int | 
     n_sub = substeps or task.substeps
     g, o = int(m.joint("grip_x").qposadr[0]), int(m.joint("object").qposadr[0])
     site = m.site("grip").id
-    home = np.asarray(models._SCENES["slide"][2])
-    lo, hi = models.workspace_box("slide", OPTIONS["finger_table"])
-    d = mujoco.MjData(m)
-    xy = home[:2] + (0.04 + offset) * np.asarray(u)
-    d.qpos[o : o + 7] = [*xy, models.rest_height(m, o), 1, 0, 0, 0]
-    mujoco.mj_forward(m, d)
+    d, home, lo, hi = c_start(m, o, u, offset)
     out = []
     for t in range(len(acts) + 1):
-        mujoco.mj_kinematics(m, d)
-        obs = np.zeros(25)
-        obs[0:3], obs[3:6] = d.site_xpos[site], d.qpos[o : o + 3]
-        w, x, y, z = d.qpos[o + 3 : o + 7]
-        obs[11] = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-        obs[12] = np.arcsin(np.clip(2 * (w * y - z * x), -1, 1))
-        out.append(obs)
+        out.append(c_observation(m, d, site, o))
         if t == len(acts):
             break
         d.ctrl[0:3] = control.gripper_target(d.qpos[g : g + 3], np.asarray(acts[t][:3], float), home, lo, hi,

@@ -34,7 +34,7 @@ ROOT = os.path.join(HERE, *[".."] * 5)
 sys.path[:0] = [HERE, ROOT, os.path.join(ROOT, "experiments", "parity")]
 
 from pads_rim_probe import DIRS, actions, measures, trace  # noqa: E402
-from pads_rim_probe_c import OPTIONS  # noqa: E402
+from pads_rim_probe_c import OPTIONS, c_observation, c_start  # noqa: E402
 
 TARGETS = ("reference", "fixed", "replay", "static")
 
@@ -67,26 +67,15 @@ def run_hand(xml: str, substeps: int, u, offset: float, acts: list, target: str,
              replay: list | None = None) -> tuple[np.ndarray, list]:  # fmt: skip
     """Observation slots 0:6 and 11:13 per control step [T + 1, 25], and the hand's tilt (degrees) per step.
     ``replay`` (``target="replay"``): the orientation target after each step, rotation vectors in degrees."""
-    from envs.fetch import control, models
+    from envs.fetch import control
 
     m = mujoco.MjModel.from_xml_string(xml)
     o, site, hand = int(m.joint("object").qposadr[0]), m.site("grip").id, m.body("hand").id
     g = int(m.joint("grip_x").qposadr[0])
-    home = np.asarray(models._SCENES["slide"][2])
-    lo, hi = models.workspace_box("slide", OPTIONS["finger_table"])
-    d = mujoco.MjData(m)
-    xy = home[:2] + (0.04 + offset) * np.asarray(u)
-    d.qpos[o : o + 7] = [*xy, models.rest_height(m, o), 1, 0, 0, 0]
-    mujoco.mj_forward(m, d)
+    d, home, lo, hi = c_start(m, o, u, offset)
     out, tilts = [], []
     for t in range(len(acts) + 1):
-        mujoco.mj_kinematics(m, d)
-        obs = np.zeros(25)
-        obs[0:3], obs[3:6] = d.site_xpos[site], d.qpos[o : o + 3]
-        w, x, y, z = d.qpos[o + 3 : o + 7]
-        obs[11] = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-        obs[12] = np.arcsin(np.clip(2 * (w * y - z * x), -1, 1))
-        out.append(obs)
+        out.append(c_observation(m, d, site, o))
         tilts.append(tilt_deg(d.xmat[hand]))
         if t == len(acts):
             break
