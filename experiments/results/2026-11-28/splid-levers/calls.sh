@@ -142,3 +142,18 @@ arm 1 slide128 $P --num-envs 128 --iterations 120 --sigma-anneal 200 &
 wait
 cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/e4.tgz -T - times.txt
 cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
+# Call f1 (2 GPUs, MPS): Push --sigmas 0.7,1 on fresh seeds 7100-7104 and 0-4; PickAndPlace 512 envs x 400 BC steps on tuning seeds 1000-1004; PickAndPlace default on 7000-7004 to 20,480 episodes
+export NCCL_NVLS_ENABLE=0 PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=$PWD:/tmp/site
+W=/tmp/f1; mkdir -p $W/arms; T0=$(date +%s)
+nvidia-cuda-mps-control -d 2>/dev/null && echo mps >> $W/times.txt
+C="--checkpoint-every 0 --compile-cache= --no-plot --seeds 5"
+arm() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$g timeout -k 10 $(( 540 - ($(date +%s) - T0) )) python3 -m splid_jax.sweep $C --run-dir $W/arms/$n "$@" > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+arm 0 push-sigma-7100 --env push --seed 7100 --iterations 80 --sigmas 0.7,1 &
+arm 0 pnp512bc400 --env pick_and_place --seed 1000 --num-envs 512 --iterations 30 --sigma-anneal 50 --bc-steps 400 &
+arm 1 pnp-default-7000 --env pick_and_place --seed 7000 &
+arm 1 push-sigma-0 --env push --seed 0 --iterations 80 --sigmas 0.7,1 &
+wait
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/f1.tgz -T - times.txt
+cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
