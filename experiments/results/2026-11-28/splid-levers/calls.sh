@@ -157,3 +157,38 @@ arm 1 push-sigma-0 --env push --seed 0 --iterations 80 --sigmas 0.7,1 &
 wait
 cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/f1.tgz -T - times.txt
 cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
+# Call f2 (2 GPUs)
+# Tuning seeds 1000-1004: Push with the horizon starting at 12/16/20 (falling to 8) in one program; PickAndPlace's
+# default (256 x 60) with 300 BC steps, and with the noise ending at 0.25 beside 0.5 in one program.
+W=/tmp/f2; mkdir -p $W/arms; T0=$(date +%s)
+nvidia-cuda-mps-control -d 2>/dev/null && echo mps >> $W/times.txt
+C="--checkpoint-every 0 --compile-cache= --no-plot --seeds 5 --seed 1000"
+arm() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$g timeout -k 10 $(( 560 - ($(date +%s) - T0) )) python3 -m splid_jax.sweep $C --run-dir $W/arms/$n "$@" > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+arm 0 push-h --env push --iterations 80 --horizons 12,16,20 --horizon-end 8 &
+arm 0 pnp-bc300 --env pick_and_place --iterations 60 --bc-steps 300 &
+arm 1 pnp-se --env pick_and_place --iterations 60 --vary sigma_end=0.25,0.5 &
+wait
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/f2.tgz -T - times.txt
+cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
+# Call f3 (2 GPUs)
+# PickAndPlace, 256 x 60: 300 BC steps with the noise ending at 0.25 or at 0.5 (one program per seed set), on the
+# tuning seeds 1000-1004 (choose) and on fresh seeds 7000-7004 (report; HER (mrl)'s).
+W=/tmp/f3; mkdir -p $W/arms; T0=$(date +%s)
+C="--checkpoint-every 0 --compile-cache= --no-plot --seeds 5 --env pick_and_place --iterations 60 --bc-steps 300 --vary sigma_end=0.25,0.5"
+arm() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$g timeout -k 10 $(( 560 - ($(date +%s) - T0) )) python3 -m splid_jax.sweep $C --run-dir $W/arms/$n "$@" > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+arm 0 pnp-bc300-se-1000 --seed 1000 &
+arm 1 pnp-bc300-se-7000 --seed 7000 &
+wait
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/f3.tgz -T - times.txt
+cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
+# Call f4 (2 GPUs)
+# PickAndPlace's candidate default (256 x 80, 300 BC steps, noise ending at 0.25; chosen on 1000-1004 in calls f2, f3)
+# to 20,480 episodes on fresh seeds 7000-7004 and 0-4 (report).
+W=/tmp/f4; mkdir -p $W/arms; T0=$(date +%s)
+C="--checkpoint-every 0 --compile-cache= --no-plot --seeds 5 --env pick_and_place --iterations 80 --bc-steps 300 --sigma-end 0.25"
+arm() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$g timeout -k 10 $(( 560 - ($(date +%s) - T0) )) python3 -m splid_jax.sweep $C --run-dir $W/arms/$n "$@" > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+arm 0 pnp-cand-7000 --seed 7000 &
+arm 1 pnp-cand-0 --seed 0 &
+wait
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/f4.tgz -T - times.txt
+cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
