@@ -138,3 +138,9 @@ def test_the_option_reaches_the_model_and_stays_slides():
     assert puck_support.support(m) == "mjx" and not models.own_groups(m)
     with pytest.raises(ValueError, match="Slide's alone"):
         models.mjcf("push", puck_support="polygon")
+    models.build("slide", puck_support="polygon")  # put_model ran with the entry, MJX's own is back
+    from mujoco.mjx._src import collision_driver
+    from mujoco.mjx._src.types import GeomType
+
+    mjx_own = collision_driver._COLLISION_FUNC[(GeomType.PLANE, GeomType.CYLINDER)]
+    assert mjx_own is not puck_support.plane_cylinder_group
