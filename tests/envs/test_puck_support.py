@@ -8,7 +8,8 @@ where quadrilaterals tie in area (a regular 16-gon, or its image under a tilt, h
 and in float32 here: over 360 flat yaws the four agree at 140 (39 %), at yaw 0 over eight places on the table at 2
 (at ``XY`` C keeps the corners at 0, 90, 157.5 and 270 degrees, ours those at 67.5, 157.5, 247.5 and 337.5), on the
 12 tilted poses at 10. Both choose among the same quadrilaterals, the same two commonest: as steps on from the first
-corner, (0, 4, 8, 12) and (0, 3, 7, 11) (C: 161 and 156 of the 360 yaws, ours 126 and 181).
+corner, (0, 4, 8, 12) and (0, 3, 7, 11) (C: 161 and 156 of the 360 yaws, ours 126 and 181). On polygons without
+ties the search keeps exactly the corners a plain transcription of C's loops keeps.
 """
 
 from __future__ import annotations
@@ -144,3 +145,46 @@ def test_the_option_reaches_the_model_and_stays_slides():
 
     mjx_own = collision_driver._COLLISION_FUNC[(GeomType.PLANE, GeomType.CYLINDER)]
     assert mjx_own is not puck_support.plane_cylinder_group
+
+
+def _greedy_quad(poly):
+    """C's search as plain loops (the oracle): for each vertex a, advance the fourth corner while the area grows,
+    after each advance the third and then the second likewise; a tie does not advance."""
+    n = len(poly)
+
+    def area(i, j, k, m):
+        return 0.5 * np.linalg.norm(np.cross(poly[i] - poly[k], poly[j] - poly[m]))
+
+    b, c, d = 1, 2, 3
+    res, best = (0, 1, 2, 3), area(0, 1, 2, 3)
+    for a in range(n):
+        while area(a, b, c, (d + 1) % n) > best:
+            d = (d + 1) % n
+            res, best = (a, b, c, d), area(a, b, c, d)
+            while area(a, b, (c + 1) % n, d) > best:
+                c = (c + 1) % n
+                res, best = (a, b, c, d), area(a, b, c, d)
+            while area(a, (b + 1) % n, c, d) > best:
+                b = (b + 1) % n
+                res, best = (a, b, c, d), area(a, b, c, d)
+        if b == a:
+            b = (b + 1) % n
+            if c == b:
+                c = (c + 1) % n
+                if d == c:
+                    d = (d + 1) % n
+    return res
+
+
+def test_the_search_is_cs_greedy_one_on_polygons_without_ties():
+    rng = np.random.default_rng(1)
+    polys, counts = np.zeros((40, puck_support.MAXV, 3), np.float32), []
+    for k in range(40):  # convex polygons, irregular enough that no two candidate areas tie
+        n = int(rng.integers(5, 21))
+        angles = np.sort(rng.uniform(0, 2 * np.pi, n))[::-1]
+        radii = rng.uniform(0.02, 0.03)
+        polys[k, :n] = np.stack([radii * np.cos(angles) * rng.uniform(0.5, 1), radii * np.sin(angles), 0 * angles], 1)
+        counts.append(n)
+    ours = np.asarray(jax.jit(jax.vmap(puck_support._quad))(jnp.asarray(polys), jnp.asarray(counts, jnp.int32)))
+    for k, n in enumerate(counts):
+        assert tuple(ours[k]) == _greedy_quad(polys[k, :n].astype(np.float64)), (k, n)
