@@ -29,6 +29,8 @@ import numpy as np
 NCON = 4
 UNUSED = 1.0  # dist of a contact slot that holds no contact
 SNAP = 0.1  # rad: a normal this close to the cylinder's axis is the cap's, this close to horizontal the wall's
+FACE = 0.0889  # rad: a box face within this of the cap gives face points (MuJoCo C switches between 0.0875 and 0.09)
+REFINE_STEPS = 24  # pattern-search steps on the normal (the step halves to 0.25 / 2**24 rad at the least)
 _SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], np.float64)  # corners
 _EDGES = np.array([(i, j) for i in range(8) for j in range(i + 1, 8) if np.abs(_SIGNS[i] - _SIGNS[j]).sum() == 2])
 # each face (axis, side) as its four corners in cyclic order
@@ -70,15 +72,51 @@ def _edge_nearest_axis(corners):
     return a + t[:, None] * (b - a)
 
 
+def _edge_rim(center, corners, radius, half):
+    """Directions across each box edge and the rim's tangent where the edge passes nearest the axis, on the cap the
+    edge's end lies nearer to (12 per rim side): where an edge crosses the rim of a tilted puck the least penetration
+    lies near them."""
+    a, b = corners[_EDGES[:, 0]], corners[_EDGES[:, 1]]
+    p = _edge_nearest_axis(corners)
+    u = _flat(p)
+    t = jnp.stack([-u[:, 1], u[:, 0], jnp.zeros_like(u[:, 0])], axis=1)
+    n = _unit(jnp.cross(b - a, t), u)
+    rim = u * radius + jnp.array([0.0, 0.0, 1.0]) * half * jnp.where(p[:, 2:] >= 0, 1.0, -1.0)
+    return n * jnp.where(jnp.sum(n * (p - rim), axis=1, keepdims=True) >= 0, 1.0, -1.0)
+
+
 def _candidates(center, axes, corners, radius, half):
-    """Candidate normals [k, 3]: the cap's axis, the box's axes, horizontal directions to corners and edges,
-    and rim-to-corner directions; each pointing from the cylinder towards the box."""
+    """Candidate normals in three groups ([k, 3] each; each pointing from the cylinder towards the box): the cap's
+    axis and the box's axes; horizontal directions to corners and edges; rim-to-corner and edge-across-rim
+    directions."""
     cap = jnp.array([[0.0, 0.0, 1.0]]) * jnp.where(center[2] >= 0, 1.0, -1.0)
     box = axes.T * jnp.where(axes.T @ center >= 0, 1.0, -1.0)[:, None]
     radial = _flat(jnp.concatenate([center[None], corners, _edge_nearest_axis(corners)]))
     rim = jnp.concatenate([_flat(corners)[:, :2] * radius, half * jnp.where(corners[:, 2:] >= 0, 1.0, -1.0)], axis=1)
     to_corner = _unit(corners - rim, radial[1:9])
-    return jnp.concatenate([cap, box, radial, to_corner])
+    return jnp.concatenate([cap, box]), radial, jnp.concatenate([to_corner, _edge_rim(center, corners, radius, half)])
+
+
+def _refine(n, sep, center, axes, size, radius, half):
+    """The best candidate ``n`` (with its separation ``sep``) improved by a pattern search on the sphere: eight
+    directions round it, the step halved where none separates more. Where a box edge crosses the rim of a tilted
+    puck, the least penetration lies between the candidates (MuJoCo C's EPA finds it there); a normal that follows
+    the puck's tilt there instead pushes the rim down along the tilted axis and turns the puck over."""
+    ring = np.array([[np.cos(a), np.sin(a)] for a in np.arange(8) * np.pi / 4])
+
+    def body(_, carry):
+        n, sep, h = carry
+        e = jnp.where(jnp.abs(n[0]) < 0.9, jnp.array([1.0, 0.0, 0.0]), jnp.array([0.0, 1.0, 0.0]))
+        a = _unit(jnp.cross(n, e), e)
+        b = jnp.cross(n, a)
+        dirs = _unit(n + h * (jnp.asarray(ring[:, :1]) * a + jnp.asarray(ring[:, 1:]) * b), n)
+        s = _separation(dirs, center, axes, size, radius, half)
+        j = jnp.argmax(s)
+        better = s[j] > sep
+        return jnp.where(better, dirs[j], n), jnp.where(better, s[j], sep), jnp.where(better, h, 0.5 * h)
+
+    n, sep, _ = jax.lax.fori_loop(0, REFINE_STEPS, body, (n, sep, jnp.asarray(0.25, n.dtype)))
+    return n, sep
 
 
 def _clip_to_disc(face, radius):
@@ -117,10 +155,15 @@ def box_cylinder(cyl_pos, cyl_mat, cyl_size, box_pos, box_mat, box_size):
     center = cyl_mat.T @ (box_pos - cyl_pos)
     axes = cyl_mat.T @ box_mat  # the box's axes as columns, in the cylinder's frame
     corners = center + (jnp.asarray(_SIGNS, center.dtype) * box_size) @ axes.T
-    normals = _candidates(center, axes, corners, radius, half)
-    seps = _separation(normals, center, axes, box_size, radius, half)
-    best = jnp.argmax(seps)
-    n, sep = normals[best], seps[best]
+    # each group's best candidate refined, the best of them kept: the least penetration can sit in a different basin
+    # from the best candidate's (a box edge across a tilted puck's rim against the cap's axis)
+    seeds = []
+    for normals in _candidates(center, axes, corners, radius, half):
+        seps = _separation(normals, center, axes, box_size, radius, half)
+        seeds.append((normals[jnp.argmax(seps)], jnp.max(seps)))
+    ns, ss = jax.vmap(lambda n, s: _refine(n, s, center, axes, box_size, radius, half))(
+        jnp.stack([n for n, _ in seeds]), jnp.stack([s for _, s in seeds]))
+    n, sep = ns[jnp.argmax(ss)], jnp.max(ss)
     # within SNAP of the axis the cap faces the box, within SNAP of horizontal the side wall: a box face resting on a
     # slightly tilted puck keeps its four points (MuJoCo C's multi-point contact does too)
     is_cap = jnp.abs(n[2]) >= np.cos(SNAP)
@@ -148,13 +191,25 @@ def box_cylinder(cyl_pos, cyl_mat, cyl_size, box_pos, box_mat, box_size):
     rim = radius * u + jnp.array([0.0, 0.0, 1.0]) * half * cap_sign
     rim_pos = jnp.broadcast_to(rim + 0.5 * sep * n, (NCON, 3))
     rim_ok = jnp.arange(4) == 0
+    # the face's points only while the face lies within FACE of the cap, as MuJoCo C's face-face contact; beyond, its
+    # deepest alone (several points at the tilted cap's normal, each at its own depth, over-stiffen the pad's press
+    # and lever the puck over)
+    face_n = axes[:, face_axis] * jnp.where(along[face_axis] > 0, 1.0, -1.0)
+    flat = jnp.abs(face_n[2]) >= np.cos(FACE)
+    # (midway along the deepest edge where two corners tie, as C)
+    low = jnp.min(jnp.where(cap_ok, cap_dist, jnp.inf))
+    tie = cap_ok & (cap_dist <= low + 1e-5)
+    mid = jnp.sum(jnp.where(tie[:, None], cap_pos, 0.0), axis=0) / jnp.maximum(jnp.sum(tie), 1)
+    first = jnp.arange(NCON) == 0
+    cap_pos = jnp.where(flat, cap_pos, jnp.where(first[:, None], mid, cap_pos))
+    cap_dist = jnp.where(flat, cap_dist, jnp.where(first, low, UNUSED))
+    cap_ok = jnp.where(flat, cap_ok, first & jnp.any(cap_ok))
     pos = jnp.where(is_cap, cap_pos, jnp.where(is_side, side_pos, rim_pos))
     ok = jnp.where(is_cap, cap_ok, jnp.where(is_side, side_ok, rim_ok))
     dist = jnp.where(is_cap, cap_dist, sep)
     dist = jnp.where(ok, dist, UNUSED)
     # a box face on a cap pushes along the face's normal, as MuJoCo C's face contacts mostly do: a pad pressed on a
     # slightly tilted puck then presses it down, not sideways
-    face_n = axes[:, face_axis] * jnp.where(along[face_axis] > 0, 1.0, -1.0)
     n = jnp.where(is_cap & (jnp.abs(face_n[2]) >= np.cos(SNAP)), face_n, n)
     world_n = cyl_mat @ n
     world_pos = cyl_pos + pos @ cyl_mat.T
