@@ -28,13 +28,15 @@ PUCK = (0.025, 0.02)
 MARGIN = 0.001
 
 
-def _mujoco(box_pos, box_euler=(0, 0, 0), cyl_euler=(0, 0, 0), libccd=False):
+def _mujoco(box_pos, box_euler=(0, 0, 0), cyl_euler=(0, 0, 0), libccd=False, box_axisangle=None):
     """MuJoCo C's contacts (dist, pos, normal) and the geoms' poses, for the pad at ``box_pos`` near the puck; by its
     native convex collider (its default), or by libccd."""
+    turn = (f'axisangle="{" ".join(map(str, box_axisangle))}"' if box_axisangle is not None
+            else f'euler="{" ".join(map(str, box_euler))}"')  # fmt: skip
     xml = f"""<mujoco><compiler angle="radian"/><option gravity="0 0 0"/><worldbody>
       <body euler="{' '.join(map(str, cyl_euler))}"><freejoint/>
         <geom name="puck" type="cylinder" size="{PUCK[0]} {PUCK[1]}" contype="0" conaffinity="0"/></body>
-      <body pos="{' '.join(map(str, box_pos))}" euler="{' '.join(map(str, box_euler))}"><freejoint/>
+      <body pos="{' '.join(map(str, box_pos))}" {turn}><freejoint/>
         <geom name="pad" type="box" size="{' '.join(map(str, PAD))}" contype="0" conaffinity="0"/></body>
     </worldbody><contact><pair geom1="pad" geom2="puck" margin="{MARGIN}" condim="4"/></contact></mujoco>"""
     m = mujoco.MjModel.from_xml_string(xml)
@@ -138,3 +140,27 @@ def test_edges_against_the_side_as_libccd():
         dist, _, normal = _contacts(poses)
         assert normal[0] @ c_normal[0] > np.cos(np.radians(4.0)), (normal[0], c_normal[0])
         assert np.min(c_dist) - 1e-5 <= np.min(dist) <= np.min(c_dist) + 3e-4
+
+
+TILTED_UNDER_A_PAD = {  # (pad centre in the puck's frame, tilt in degrees): a pad sunk near the rim of a tilted puck
+    "cap, 7 deg": ((-0.0163, -0.0158, 0.0492), 7),
+    "edge across the rim, 12 deg": ((-0.0163, -0.0158, 0.0492), 12),
+    "edge across the rim, 16 deg": ((-0.0163, -0.0158, 0.0492), 16),
+    "edge across the rim, 25 deg": ((-0.0163, -0.0158, 0.0492), 25),
+    "nearer the rim, 9 deg": ((-0.0153, -0.0221, 0.0497), 9),
+    "nearer the rim, 16 deg": ((-0.0153, -0.0221, 0.0497), 16),
+}
+
+
+@pytest.mark.parametrize("name", TILTED_UNDER_A_PAD)
+def test_pad_on_a_tilted_puck_as_mujoco_c(name):
+    """Where the pads turned the puck over: past C's face-face angle one point, and where a pad's edge crosses the rim
+    the least penetration between the candidates (C's EPA finds it), not the tilted cap's normal."""
+    centre, tilt = TILTED_UNDER_A_PAD[name]
+    axis = np.array([-0.1, 0.122, 0.0]) / np.hypot(0.1, 0.122)
+    c_dist, c_pos, c_normal, poses = _mujoco(centre, box_axisangle=(*axis, np.radians(tilt)))
+    dist, pos, normal = _contacts(poses)
+    assert len(dist) == len(c_dist) == 1, (dist, c_dist)
+    assert dist[0] == pytest.approx(c_dist[0], abs=1e-4)
+    assert normal[0] @ c_normal[0] > np.cos(0.12), (normal, c_normal)
+    assert np.linalg.norm(pos[0] - c_pos[0]) < 2.5e-3
