@@ -10,13 +10,15 @@ box face's normal (``tests/envs/test_box_cylinder.py`` checks both).
 
 How: in the cylinder's frame, the normal is the separating-axis candidate of least penetration among the cap's
 axis, the box's three axes, the horizontal directions from the cylinder's axis to the box's corners and to the
-points of its edges nearest that axis, and the directions from the rim to each corner. For a box whose axes include
-the cylinder's (the fingers on an upright puck, at any yaw) that set holds the exact minimum; for a tilted box it is
-an approximation whose normal errs by about the tilt where an edge crosses the rim. A normal within ``SNAP`` of the
+points of its edges nearest that axis, the directions from the rim to each corner and those across each edge and
+the rim's tangent; the best of each of three groups is refined by a pattern search on the sphere and the best kept,
+so that where a box edge crosses a tilted puck's rim the normal is the least penetration, as MuJoCo C's EPA finds
+it, not the tilted cap's axis (which levers the puck over). A normal within ``SNAP`` of the
 axis selects the cap, within ``SNAP`` of horizontal the side wall, so a box face on a slightly tilted puck (or float
 rounding in its tilt) keeps a face contact rather than a point, pushing along the box face's normal. The contact
 points then follow the feature of the cylinder that the normal selects: on a cap, the corners of the box's face
-that faces it, clipped to the disc along the face's edges, each at its own depth; on the side wall, the wall's
+that faces it, clipped to the disc along the face's edges, each at its own depth, while the face lies within
+``FACE`` of the cap (C's face-face contact), else the deepest alone; on the side wall, the wall's
 vertical segment clipped to the box's extent along it (two points); on the rim, the rim point (one).
 """
 
