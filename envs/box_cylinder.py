@@ -32,7 +32,7 @@ NCON = 4
 UNUSED = 1.0  # dist of a contact slot that holds no contact
 SNAP = 0.1  # rad: a normal this close to the cylinder's axis is the cap's, this close to horizontal the wall's
 FACE = 0.0889  # rad: a box face within this of the cap gives face points (MuJoCo C switches between 0.0875 and 0.09)
-REFINE_STEPS = 24  # pattern-search steps on the normal (the step halves to 0.25 / 2**24 rad at the least)
+REFINE_STEPS = 12  # pattern-search steps on the normal (the step halves to 0.25 / 2**12 rad at the least)
 _SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], np.float64)  # corners
 _EDGES = np.array([(i, j) for i in range(8) for j in range(i + 1, 8) if np.abs(_SIGNS[i] - _SIGNS[j]).sum() == 2])
 # each face (axis, side) as its four corners in cyclic order
