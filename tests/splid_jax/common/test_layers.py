@@ -30,8 +30,8 @@ def test_row_blocks_is_the_largest_divisor_up_to_the_square_root():
 def test_mlp_has_flax_layers_parameters_outputs_and_gradients():
     ours, theirs = MLP((16, 16), 3, activation="relu", layer_norm=True), FlaxMLP((16, 16), 3)
     x = jax.random.normal(jax.random.PRNGKey(0), (4, 60, 5))  # 4 vmapped members of 60 rows
-    params = ours.init(jax.random.PRNGKey(1), x[0])
-    reference = theirs.init(jax.random.PRNGKey(1), x[0])
+    params = jax.jit(ours.init)(jax.random.PRNGKey(1), x[0])
+    reference = jax.jit(theirs.init)(jax.random.PRNGKey(1), x[0])
     assert jax.tree_util.tree_structure(params) == jax.tree_util.tree_structure(reference)
     for a, b in zip(jax.tree_util.tree_leaves(params), jax.tree_util.tree_leaves(reference), strict=True):
         np.testing.assert_array_equal(a, b)
@@ -41,8 +41,16 @@ def test_mlp_has_flax_layers_parameters_outputs_and_gradients():
     def loss(net, p, xs):
         return jnp.sum(jnp.sin(net.apply(p, xs)))
 
-    ours_grad = jax.vmap(jax.grad(lambda p, xs: loss(ours, p, xs)), in_axes=(None, 0))(params, x)
-    theirs_grad = jax.vmap(jax.grad(lambda p, xs: loss(theirs, p, xs)), in_axes=(None, 0))(params, x)
-    np.testing.assert_allclose(ours.apply(params, x), theirs.apply(params, x), rtol=1e-5, atol=1e-6)
+    # one compiled program per network (op by op, each primitive would compile on its own)
+    ours_grad, ours_out = jax.jit(
+        lambda p, xs: (jax.vmap(jax.grad(lambda p, xs: loss(ours, p, xs)), in_axes=(None, 0))(p, xs), ours.apply(p, xs))
+    )(params, x)
+    theirs_grad, theirs_out = jax.jit(
+        lambda p, xs: (
+            jax.vmap(jax.grad(lambda p, xs: loss(theirs, p, xs)), in_axes=(None, 0))(p, xs),
+            theirs.apply(p, xs),
+        )
+    )(params, x)
+    np.testing.assert_allclose(ours_out, theirs_out, rtol=1e-5, atol=1e-6)
     for a, b in zip(jax.tree_util.tree_leaves(ours_grad), jax.tree_util.tree_leaves(theirs_grad), strict=True):
         np.testing.assert_allclose(a, b, rtol=1e-4, atol=1e-5)

@@ -21,12 +21,18 @@ T, N = 12, 5
 def traj():
     env = envs.make("point", max_episode_steps=T)
     policy = make_policy(env.obs_size, env.goal_size, env.action_size, (8,), normalise=False)
-    return env, explore(env, policy, policy.init(jax.random.PRNGKey(0)), jax.random.PRNGKey(1), N, jnp.float32(1.0))
+    # one compiled program (op by op, each primitive would compile on its own)
+    episodes = jax.jit(lambda k0, k1: explore(env, policy, policy.init(k0), k1, N, jnp.float32(1.0)))
+    return env, episodes(jax.random.PRNGKey(0), jax.random.PRNGKey(1))
+
+
+def relabelled(env, tr, mode, seed):
+    return jax.jit(gcsl.relabel, static_argnums=(0, 2))(env, tr.seen(), mode, jax.random.PRNGKey(seed))
 
 
 def test_final_pairs_every_step_with_the_episodes_last_achieved_goal(traj):
     env, tr = traj
-    c = gcsl.relabel(env, tr.seen(), "final", jax.random.PRNGKey(0))
+    c = relabelled(env, tr, "final", 0)
     np.testing.assert_array_equal(c.goal.reshape(T, N, -1), np.broadcast_to(tr.achieved[T], (T, N, 2)))
     np.testing.assert_array_equal(c.action.reshape(T, N, -1), tr.actions)
     assert bool(c.accept.all()) and int(c.replay_steps) == 0
@@ -37,7 +43,7 @@ def test_future_goals_come_uniformly_from_later_steps_of_the_same_episode(traj):
     achieved = np.asarray(tr.achieved)
     later = []
     for seed in range(40):
-        goal = np.asarray(gcsl.relabel(env, tr.seen(), "future", jax.random.PRNGKey(seed)).goal).reshape(T, N, 2)
+        goal = np.asarray(relabelled(env, tr, "future", seed).goal).reshape(T, N, 2)
         for t in range(T):
             for n in range(N):
                 (match,) = np.nonzero((achieved[:, n] == goal[t, n]).all(-1))

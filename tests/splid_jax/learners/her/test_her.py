@@ -245,13 +245,13 @@ def test_layer_norm_in_both_networks_where_configured():
 
 
 def test_bfloat16_computes_the_hidden_layers_in_bfloat16_and_keeps_parameters_and_outputs_float32():
-    def dtypes(her):
-        state = her.init(jax.random.PRNGKey(0))
+    def dtypes(her):  # traced for their types alone (jax.eval_shape): nothing is compiled
+        state = jax.eval_shape(her.init, jax.random.PRNGKey(0))
         x = jnp.ones((2, state.critic["params"]["Dense_0"]["kernel"].shape[0]))
         mlp = her.critic.clone(parent=None)
-        _, seen = mlp.apply(state.critic, x, capture_intermediates=True)
-        inner = [v[0].dtype for k, v in jax.tree_util.tree_flatten_with_path(seen)[0] if "Dense_0" in str(k)]
-        out = mlp.apply(state.critic, x)
+        _, seen = jax.eval_shape(lambda c, x: mlp.apply(c, x, capture_intermediates=True), state.critic, x)
+        inner = [v.dtype for k, v in jax.tree_util.tree_flatten_with_path(seen)[0] if "Dense_0" in str(k)]
+        out = jax.eval_shape(mlp.apply, state.critic, x)
         params = {leaf.dtype for leaf in jax.tree_util.tree_leaves((state.critic, state.policy.params))}
         return inner, out.dtype, params
 

@@ -84,8 +84,9 @@ def test_an_epoch_of_active_steps_takes_those_steps_and_leaves_the_rest_as_no_op
     # two active: the first two of the six steps' minibatches, and Adam counts two steps
     ps, os = pstate, opt.init(pstate.params)
     losses = []
+    step = jax.jit(lambda ps, os, k: bc_step(policy, opt, ps, os, relabel_buffer.sample(buf, k, 8), 1.0))
     for k in jax.random.split(key, 6)[:2]:
-        ps, os, _, loss = bc_step(policy, opt, ps, os, relabel_buffer.sample(buf, k, 8), 1.0)
+        ps, os, _, loss = step(ps, os, k)
         losses.append(loss)
     two = epoch(jnp.int32(2))
     chex.assert_trees_all_close(two[0].params, ps.params, rtol=1e-6, atol=1e-7)
