@@ -267,10 +267,11 @@ def test_targets_move_every_target_every_steps_only_once_warm():
     her = _her(
         update_every=0, n_batches=10, target_every=5, warm_up=0, hidden=(8,), batch_size=8, buffer_transitions=500
     )
-    state = her.init(jax.random.PRNGKey(1))
+    state = jax.jit(her.init)(jax.random.PRNGKey(1))
     episodes, valid, _ = jax.jit(her.explore)(state.policy, jax.random.PRNGKey(2))
-    cold = state.replace(buffer=episode_buffer.buffer_insert(state.buffer, episodes, valid[:0].any() & valid))
-    warm = state.replace(buffer=episode_buffer.buffer_insert(state.buffer, episodes, valid))
+    insert = jax.jit(episode_buffer.buffer_insert)
+    cold = state.replace(buffer=insert(state.buffer, episodes, valid[:0].any() & valid))
+    warm = state.replace(buffer=insert(state.buffer, episodes, valid))
     for start, moves in ((cold, False), (warm, True)):
         after, _ = jax.jit(her.updates)(start, jax.random.PRNGKey(3))
         leaf = lambda s: jax.tree_util.tree_leaves(s.target_critic)[-1]  # noqa: E731
@@ -285,19 +286,19 @@ def test_blocks_of_target_every_steps_equal_the_steps_one_at_a_time():
     # from target networks that move after every target_every-th step
     small = dict(hidden=(8,), batch_size=8, buffer_transitions=500)
     her = _her(update_every=0, n_batches=6, target_every=3, warm_up=0, **small)
-    state = her.init(jax.random.PRNGKey(1))
+    state = jax.jit(her.init)(jax.random.PRNGKey(1))  # compiled whole here and below: op by op is slower
     episodes, valid, _ = jax.jit(her.explore)(state.policy, jax.random.PRNGKey(2))
-    state = state.replace(buffer=episode_buffer.buffer_insert(state.buffer, episodes, valid))
+    state = state.replace(buffer=jax.jit(episode_buffer.buffer_insert)(state.buffer, episodes, valid))
     key = jax.random.PRNGKey(3)
     blocked, losses = jax.jit(her.updates)(state, key)
-    batches = her.draw(state, key, her.n_updates)
+    batches = jax.jit(lambda s, k: her.draw(s, k, her.n_updates))(state, key)
     step = jax.jit(lambda h, tr: her.train_step(h, (tr, her.td_targets(h, tr))))
     h, critic_losses = state, []
     for i in range(her.n_updates):
         h, step_losses = step(h, jax.tree_util.tree_map(lambda x, i=i: x[i], batches))
         critic_losses.append(float(step_losses["critic_loss"]))
         if (i + 1) % 3 == 0:
-            moved = her._moved_targets(h)
+            moved = jax.jit(her._moved_targets)(h)
             h = h.replace(target_actor=moved.target_actor, target_critic=moved.target_critic)
     np.testing.assert_allclose(losses["critic_loss"], critic_losses, rtol=1e-5)
     for a, b in zip(jax.tree_util.tree_leaves(blocked), jax.tree_util.tree_leaves(h), strict=True):
