@@ -117,19 +117,23 @@ def main(argv=None) -> int:
     p.add_argument("--yaws", default="0", help="the puck's start turns about its axis (degrees), comma-separated")
     p.add_argument("--upright", action="store_true", help="both pucks start exactly upright")
     p.add_argument("--support", default="polygon", help="our puck_support (mjx: MJX's plane-cylinder contact)")
+    p.add_argument("--env-options", default="", help="options for our Slide over the probe's (comma-separated k=v)")
     p.add_argument("--out", required=True)
     args = p.parse_args(argv)
     global UPRIGHT
     UPRIGHT = args.upright
-    options = probe.OPTIONS + f",puck_support={args.support}"
+    from splid_jax.common.values import parse_overrides
+
+    base = probe.OPTIONS + f",puck_support={args.support}"
+    overrides = {**parse_overrides(base), **parse_overrides(args.env_options)}
+    options = ",".join(f"{k}={v}" for k, v in overrides.items())  # the later key wins
     import jax
 
     import envs
-    from splid_jax.common.values import parse_overrides
     from splid_jax.reference.extra import import_reference
 
     import_reference()
-    env = envs.make("slide", **parse_overrides(options))
+    env = envs.make("slide", **overrides)
     step = jax.jit(env.step)
     rows = []
     for name in args.dirs.split(","):

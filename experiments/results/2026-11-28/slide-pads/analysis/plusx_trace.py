@@ -146,7 +146,7 @@ def main(argv=None) -> int:
     p.add_argument("--offset", type=float, default=0.025)
     p.add_argument("--yaw", type=float, default=0.0)
     p.add_argument("--support", default="mjx")
-    p.add_argument("--env-options", default="", help="extra options for our Slide (comma-separated k=v)")
+    p.add_argument("--env-options", default="", help="options for our Slide over the probe's (comma-separated k=v)")
     p.add_argument("--substeps", default="5,6,7", help="control steps whose substeps the reference's trace records")
     p.add_argument("--out", required=True)
     args = p.parse_args(argv)
@@ -155,8 +155,10 @@ def main(argv=None) -> int:
     from splid_jax.reference.extra import import_reference
 
     import_reference()
-    options = probe.OPTIONS + f",puck_support={args.support}" + (f",{args.env_options}" if args.env_options else "")
-    env = envs.make("slide", **parse_overrides(options))
+    base = probe.OPTIONS + f",puck_support={args.support}"
+    overrides = {**parse_overrides(base), **parse_overrides(args.env_options)}
+    options = ",".join(f"{k}={v}" for k, v in overrides.items())  # the later key wins
+    env = envs.make("slide", **overrides)
     u = np.asarray(probe.DIRS[args.dir])
     acts = probe.actions(u, -0.25, 0.5)
     out = {"env_options": options, "dir": args.dir, "offset": args.offset, "yaw": args.yaw,
