@@ -90,6 +90,7 @@ _SCENES = {
 }
 KINDS = tuple(_SCENES)
 
+
 DRIVES = ("pd", "weld")
 WELD_SOLREF = "0.02 1"  # the reference's mocap weld: time constant, damping ratio
 WELD_SOLIMP = "0.9 0.95 0.001 0.5 2"
@@ -162,7 +163,6 @@ def mjcf(
     finger_table: float = 0.0,
     finger_drive: str = "reference",
     puck_support: str = "mjx",
-    weld_timeconst: float | None = None,
 ) -> str:
     """The MJCF text of task ``kind`` (one of ``KINDS``); ``table`` is the table's collision shape
     (``tables_for(kind)``), ``finger`` the closed finger block's (``fingers_for(kind)``).
@@ -177,7 +177,7 @@ def mjcf(
     connect constraint with the reference weld's solref and solimp (``WELD_SOLREF``, ``WELD_SOLIMP``)
     instead of the PD drive: the reference's drive law on our gripper. Whoever steps the model puts the
     mocap body at the grip site's target (the tasks' field ``drive``, ``experiments/parity/slide_c.py``);
-    ``ctrl[0:3]`` then moves nothing. ``weld_timeconst`` (s): that weld's time constant (damping ratio 1).
+    ``ctrl[0:3]`` then moves nothing.
 
     ``finger_table`` > 0: the fingers reach ``REFERENCE_FINGER_BELOW_SITE``
     below the grip site and touch the table with this friction (condim 3), so a gripper driven down at
@@ -192,7 +192,7 @@ def mjcf(
     if finger not in fingers_for(kind):
         raise ValueError(f"finger {finger!r} for {kind}: one of {fingers_for(kind)}")
     for name, value in (("gripper_mass", gripper_mass), ("drive_omega", drive_omega),
-                        ("drive_damping_ratio", drive_damping_ratio), ("weld_timeconst", weld_timeconst)):
+                        ("drive_damping_ratio", drive_damping_ratio)):
         if value is not None and not value > 0:
             raise ValueError(f"{name} must be > 0, got {value}")
     if drive_damping not in ("joint", "actuator"):
@@ -216,11 +216,11 @@ def mjcf(
     joint_kv, bias_kv = (f"{kv:.6g}", "0") if drive_damping == "joint" else ("0", f"{-kv:.6g}")
     weld = target_body = ""
     if drive == "weld":  # no PD forces (the z actuator keeps only the gravity bias); a constraint pulls instead
-        kp, joint_kv, bias_kv, solref = 0.0, "0", "0", f"{weld_timeconst} 1" if weld_timeconst else WELD_SOLREF
+        kp, joint_kv, bias_kv = 0.0, "0", "0"
         target_body = f'<body name="target" mocap="true" pos="{_fmt(gx, gy, gz)}"/>'
         weld = f"""
   <equality>
-    <connect body1="gripper" body2="target" anchor="0 0 0" solref="{solref}" solimp="{WELD_SOLIMP}"/>
+    <connect body1="gripper" body2="target" anchor="0 0 0" solref="{WELD_SOLREF}" solimp="{WELD_SOLIMP}"/>
   </equality>"""
     obj_half = (OBJECT_HALF, OBJECT_HALF, PUCK_HALF_HEIGHT if slide else OBJECT_HALF)
     rest_z = TABLE_TOP + obj_half[2]

@@ -5,25 +5,28 @@ observation in the reference's order (10 for Reach), achieved goal = object posi
 for Reach), sparse reward ``-(d > threshold)``, 50-step episodes, action ``a`` in [-1, 1]^4 moving
 the gripper target by ``0.05 * a[:3]`` per 0.04 s control step.
 
-Gripper target: as in the reference, the *current* grip position plus ``0.05 * a[:3]``, clipped to a workspace box
-whose floor keeps the fingertips at or above the table (with ``finger_table`` the floor lies 2.5 cm lower and the
-fingers' contact with the table holds them), then within the reference arm's reach (``control.within_reach``;
-``workspace="box"`` drops it). The target is the actuator control, which ``Physics`` holds (with ``drive="weld"``,
-``simulate`` puts a mocap body there).
+Gripper target: as in the reference, the *current* grip position plus ``0.05 * a[:3]``, clipped to
+a workspace box whose floor keeps the fingertips at or above the table (with ``finger_table`` the
+floor lies 2.5 cm lower and the fingers' contact with the table holds them), then within the reference
+arm's reach (``control.within_reach``; ``workspace="box"`` drops it). The target is the actuator
+control, which ``Physics`` holds (with ``drive="weld"``, ``simulate`` puts a mocap body there).
 
 ``State.physics`` (a ``Physics``) is the complete simulator state: qpos, qvel, ctrl, time and the
 Newton solver's warm start. Restoring a saved ``State`` and replaying the same actions reproduces the
 trajectory bit for bit, which SELECT's restore-and-replay relies on.
 
-Defaults: 10 substeps of 4 ms (the reference takes 20 of 2 ms) and Newton with 4 iterations and 4 line-search
-iterations (Slide: 10, since with 4 a resting low-friction puck crept in float32 MJX). That halves the physics cost
-and keeps the scripted controllers' success; coarser steps or fewer iterations change what SPLID learns
-(``experiments/NOTES.md``). All are task fields (``timestep``, ``substeps``, ``iterations``, ``ls_iterations``).
+Defaults: 10 substeps of 4 ms (the reference takes 20 of 2 ms) and Newton with 4 iterations and 4
+line-search iterations (Slide: 10, since with 4 a resting low-friction puck crept in float32 MJX).
+That halves the physics cost and keeps the scripted controllers' success; coarser steps or fewer
+iterations change what SPLID learns (``experiments/NOTES.md``). All are task fields (``timestep``,
+``substeps``, ``iterations``, ``ls_iterations``).
 
-The task's ``physics`` picks the code that steps MJX: ``kernels`` (the default) with parts of the step replaced by
-faster equivalents equal to float rounding (``envs/fetch/kernels.py``: MJX's small dense Cholesky solves unrolled,
-and on a GPU the solve and box contacts as Pallas kernels), or ``mjx``, MJX as it is. A MuJoCo release the kernels
-were not checked on runs ``mjx`` (``envs/physics.py``)."""
+The task's ``physics`` picks the code that steps MJX: ``kernels`` (the default) with parts of the
+step replaced by faster equivalents equal to float rounding (``envs/fetch/kernels.py``: MJX's small
+dense Cholesky solves unrolled, and on a GPU the solve and box contacts as Pallas kernels), or
+``mjx``, MJX as it is. A MuJoCo release the kernels were not checked on runs ``mjx``
+(``envs/physics.py``).
+"""
 
 from __future__ import annotations
 
@@ -107,8 +110,6 @@ class _FetchTask(GoalEnv):
     # The gripper's mass in kg (0: the task's, models.mjcf): how hard the weld drive presses (Slide's pads sink
     # into the puck as deep as the reference's at 22 kg, its arm's effective mass along z at the grip site)
     gripper_mass: float = experimental(0.0, recorded_when_set=True)
-    # The weld drive's time constant in s (0: the reference weld's, models.WELD_SOLREF); drive="weld" only
-    weld_timeconst: float = experimental(0.0, recorded_when_set=True)
     # How Slide's puck stands on the table: MJX's plane-cylinder contact (3 points) or MuJoCo C's (polygon: 4 corners
     # of a 16-gon round the rim, chosen as the reference's collider chooses them; envs/puck_support.py)
     puck_support: str = experimental("mjx", recorded_when_set=True)
@@ -154,8 +155,6 @@ class _FetchTask(GoalEnv):
         supports = puck_support.SUPPORTS if n == "slide" else ("mjx",)
         check(self.puck_support in supports, f"{n}.puck_support", self.puck_support, "one of " + ", ".join(supports))
         check(0 <= self.gripper_mass <= 100, f"{n}.gripper_mass", self.gripper_mass, "in [0, 100] kg (0: the task's)")
-        ok = self.weld_timeconst == 0 or (self.drive == "weld" and 0.005 <= self.weld_timeconst <= 0.1)
-        check(ok, f"{n}.weld_timeconst", self.weld_timeconst, "0, or in [0.005, 0.1] s with drive=weld")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -185,7 +184,7 @@ class _FetchTask(GoalEnv):
             finger=str(self.finger),
             drive=str(self.drive),
             finger_table=float(self.finger_table),
-            **{k: float(getattr(self, k)) for k in ("gripper_mass", "weld_timeconst") if getattr(self, k)},
+            **({"gripper_mass": float(self.gripper_mass)} if self.gripper_mass else {}),
             **({"puck_support": str(self.puck_support)} if self.puck_support != "mjx" else {}),
         )
 

@@ -137,8 +137,6 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("pick_and_place", "finger_drive", "instant"),
         ("slide", "finger", "capsule"),  # the round tips or the reference's pads
         ("slide", "gripper_mass", -1.0),
-        ("slide", "weld_timeconst", 0.001),
-        ("push", "weld_timeconst", 0.03),  # the weld drive's alone (drive="pd" here)
         ("slide", "puck_support", "box"),
         ("push", "puck_support", "polygon"),  # Slide's puck alone
     ],
