@@ -6,8 +6,7 @@ the small dense Cholesky solves unrolled (``cholesky``, ``envs/small_cholesky.py
 out (``solver_loops``, ``envs/solver_loops.py``), the whole solve as one program per env (``solver_loops``
 ``fused``, ``envs/fused_solver.py``) and the box contacts likewise (``collision``, ``envs/fused_collision.py``),
 the last two Pallas kernels on a GPU. A model whose fingers are boxes against a cylinder gets MJX's missing
-box-cylinder contact in the same block (``envs/box_cylinder.py``), a Slide asking for it MuJoCo C's puck support
-(``envs/puck_support.py``)."""
+box-cylinder contact in the same block (``envs/box_cylinder.py``)."""
 
 from __future__ import annotations
 
@@ -48,8 +47,7 @@ def mjx_with_kernels(task):
     (the kernels up to ``kernel_envs`` envs, with ``kernel_warps`` warps per env), on the backend being traced
     for: the step's only way to the replaced functions. The modules that reach into MJX's private code are imported
     here, so a task on a MuJoCo whose private code moved still imports and runs stock MJX."""
-    from envs import fused_collision, fused_solver, mjx_patch, small_cholesky, solver_loops
-    from envs.fetch import models
+    from envs import box_cylinder, fused_collision, fused_solver, mjx_patch, small_cholesky, solver_loops
 
     backend = jax.default_backend()
     newton, line_search = solver_loops.writes_out(task.solver_loops, backend)
@@ -59,7 +57,7 @@ def mjx_with_kernels(task):
         while_loop=solver_loops.solver_while(task.iterations) if newton else None,
         line_search=solver_loops.written_out_scan if line_search else None,
         solve=fused_solver.fused(**opts) if runs_as_kernel(task.solver_loops, backend) else None,
-        collide={**models.own_groups(task.mj_model),
+        collide={**box_cylinder.groups_for(task.mj_model),
                  **(fused_collision.groups(**opts) if runs_as_kernel(task.collision, backend) else {})},
     )
 

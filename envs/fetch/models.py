@@ -40,7 +40,6 @@ import functools
 import mujoco
 import numpy as np
 
-from envs import puck_support as puck_support_mod
 from envs.fetch import slide_fingers
 from envs.fetch.control import ARM_REACH_CENTER, ARM_REACH_CENTER_DEFAULT
 
@@ -162,7 +161,6 @@ def mjcf(
     drive: str = "pd",
     finger_table: float = 0.0,
     finger_drive: str = "reference",
-    puck_support: str = "mjx",
 ) -> str:
     """The MJCF text of task ``kind`` (one of ``KINDS``); ``table`` is the table's collision shape
     (``tables_for(kind)``), ``finger`` the closed finger block's (``fingers_for(kind)``).
@@ -183,8 +181,7 @@ def mjcf(
     below the grip site and touch the table with this friction (condim 3), so a gripper driven down at
     the table presses on it and drags, as the reference's does under its mocap weld; 0: no such contact.
 
-    ``finger_drive`` (PickAndPlace's free fingers): one of ``FINGER_DRIVES``, see there. ``puck_support``
-    (Slide): how the puck stands on the table, MJX's plane-cylinder contact or MuJoCo C's (``envs/puck_support.py``)."""
+    ``finger_drive`` (PickAndPlace's free fingers): one of ``FINGER_DRIVES``, see there."""
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
     if table not in tables_for(kind):
@@ -203,9 +200,6 @@ def mjcf(
         raise ValueError(f"finger_drive must be one of {FINGER_DRIVES}, got {finger_drive!r}")
     if finger_table < 0:
         raise ValueError(f"finger_table must be >= 0, got {finger_table}")
-    if puck_support != "mjx" and kind != "slide":
-        raise ValueError(f"puck_support {puck_support!r} for {kind}: Slide's alone")
-    custom = puck_support_mod.mjcf(puck_support)
     (tx, ty, tz), (hx, hy, hz), (gx, gy, gz) = _SCENES[kind]
     has_object = kind != "reach"
     free_fingers = kind == "pick_and_place"
@@ -310,7 +304,7 @@ def mjcf(
         )
 
     return f"""<mujoco model="fetch_{kind}">
-  <compiler angle="radian" autolimits="true"/>{custom}
+  <compiler angle="radian" autolimits="true"/>
   <option timestep="{timestep:.6g}" integrator="Euler" solver="Newton" iterations="{iterations}"
           ls_iterations="{ls_iterations}" cone="pyramidal"/>
   <worldbody>
@@ -347,21 +341,15 @@ def rest_height(m: mujoco.MjModel, object_q: int) -> float:
 
 def own_contacts(m: mujoco.MjModel):
     """The block within which MJX knows the contacts model ``m`` needs and it lacks (box-cylinder:
-    ``envs/box_cylinder.py``; C's puck support: ``envs/puck_support.py``); put_model, make_data and a step's trace
-    of ``m`` must run inside it."""
-    groups = own_groups(m)
+    ``envs/box_cylinder.py``); put_model, make_data and a step's trace of ``m`` must run inside it."""
+    from envs import box_cylinder
+
+    groups = box_cylinder.groups_for(m)
     if not groups:
         return contextlib.nullcontext()
     from envs import mjx_patch
 
     return mjx_patch.patched_mjx(collide=groups)
-
-
-def own_groups(m: mujoco.MjModel) -> dict:
-    """The collision driver's entries that model ``m`` needs beyond MJX's own."""
-    from envs import box_cylinder
-
-    return {**box_cylinder.groups_for(m), **puck_support_mod.groups_for(m)}
 
 
 @functools.cache

@@ -35,7 +35,6 @@ import dataclasses
 import jax
 import jax.numpy as jnp
 
-from envs import puck_support
 from envs.base import GoalEnv, State, flag_invalid, make_data, mjx_substeps
 from envs.fetch import control, kernels, models, observation
 from envs.fetch.observation import Physics
@@ -110,9 +109,6 @@ class _FetchTask(GoalEnv):
     # The gripper's mass in kg (0: the task's, models.mjcf): how hard the weld drive presses (Slide's pads sink
     # into the puck as deep as the reference's at 22 kg, its arm's effective mass along z at the grip site)
     gripper_mass: float = experimental(0.0, recorded_when_set=True)
-    # How Slide's puck stands on the table: MJX's plane-cylinder contact (3 points) or MuJoCo C's (polygon: 4 corners
-    # of a 16-gon round the rim, chosen as the reference's collider chooses them; envs/puck_support.py)
-    puck_support: str = experimental("mjx", recorded_when_set=True)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -152,8 +148,6 @@ class _FetchTask(GoalEnv):
         check(ok, f"{n}.grasped_starts", self.grasped_starts, grasp_range)
         check(0 <= self.floor_clearance <= 0.1, f"{n}.floor_clearance", self.floor_clearance, "in [0, 0.1] m")
         check(0 <= self.finger_table <= 2, f"{n}.finger_table", self.finger_table, "in [0, 2]")
-        supports = puck_support.SUPPORTS if n == "slide" else ("mjx",)
-        check(self.puck_support in supports, f"{n}.puck_support", self.puck_support, "one of " + ", ".join(supports))
         check(0 <= self.gripper_mass <= 100, f"{n}.gripper_mass", self.gripper_mass, "in [0, 100] kg (0: the task's)")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
@@ -185,7 +179,6 @@ class _FetchTask(GoalEnv):
             drive=str(self.drive),
             finger_table=float(self.finger_table),
             **({"gripper_mass": float(self.gripper_mass)} if self.gripper_mass else {}),
-            **({"puck_support": str(self.puck_support)} if self.puck_support != "mjx" else {}),
         )
 
     @property

@@ -137,8 +137,6 @@ def test_reset_samples_stay_in_their_ranges(name):
         ("pick_and_place", "finger_drive", "instant"),
         ("slide", "finger", "capsule"),  # the round tips or the reference's pads
         ("slide", "gripper_mass", -1.0),
-        ("slide", "puck_support", "box"),
-        ("push", "puck_support", "polygon"),  # Slide's puck alone
     ],
 )
 def test_bad_overrides_fail_naming_the_field(name, field, value):
