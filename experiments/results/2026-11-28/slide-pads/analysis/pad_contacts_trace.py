@@ -35,9 +35,8 @@ def main(support: str, dirn: str, offset: float, yaw: float, out: str) -> None:
 
     import envs
     from envs.box_cylinder import box_cylinder
-    from splid_jax.common.values import parse_overrides
 
-    env = envs.make("slide", **parse_overrides(probe.OPTIONS + f",puck_support={support}"))
+    env = envs.make("slide", **probe.task_options(support))
     one = dataclasses.replace(env, substeps=1)
     m = env.mj_model
     d = mujoco.MjData(m)

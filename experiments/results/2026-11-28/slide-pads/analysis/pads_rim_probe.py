@@ -16,6 +16,7 @@ reference) the pads' largest tilt while dragged; ``--trace``: those per step.
 from __future__ import annotations
 
 import argparse
+import gzip
 import json
 import os
 import sys
@@ -26,6 +27,27 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), *[".."] * 5))
 
 OPTIONS = "finger=pads,finger_table=1,drive=weld,gripper_mass=22"
 DIRS = {"+x": (1.0, 0.0), "+y": (0.0, 1.0), "-y": (0.0, -1.0), "diag": (0.7071, 0.7071)}
+
+
+def task_options(support: str = "mjx", extra: str = "") -> dict:
+    """Our Slide's options for the probes: the pads' on the puck ``support`` (MJX's plane needs no option; the polygon
+    support left the package and is in git history at 56a0a5b), ``extra`` (k=v,...) replacing any of them."""
+    from splid_jax.common.values import parse_overrides
+
+    base = OPTIONS if support == "mjx" else f"{OPTIONS},puck_support={support}"
+    return {**parse_overrides(base), **parse_overrides(extra)}
+
+
+def read_json(path: str):
+    """A probe's record, plain or gzip-compressed (``.gz``)."""
+    with (gzip.open(path, "rt") if path.endswith(".gz") else open(path)) as fh:
+        return json.load(fh)
+
+
+def write_json(path: str, record, **dump) -> None:
+    """A probe's record, gzip-compressed where ``path`` ends in ``.gz`` (the large per-turn records)."""
+    with (gzip.open(path, "wt") if path.endswith(".gz") else open(path, "w")) as fh:
+        json.dump(record, fh, **dump)
 
 
 def actions(u, press: float, drag: float) -> list:

@@ -33,7 +33,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.join(HERE, *[".."] * 5)
 sys.path[:0] = [HERE, ROOT, os.path.join(ROOT, "experiments", "parity")]
 
-from pads_rim_probe import DIRS, actions, measures, trace  # noqa: E402
+from pads_rim_probe import DIRS, actions, measures, trace, write_json  # noqa: E402
 from pads_rim_probe_c import OPTIONS, c_observation, c_start  # noqa: E402
 
 TARGETS = ("reference", "fixed", "replay", "static")
@@ -152,8 +152,7 @@ def main(argv=None) -> int:
         head = {"options": OPTIONS, "fit": args.fit, "hand": params, "timestep": args.timestep,
                 "static_rotvec_deg": args.static_rotvec,
                 "press": args.press, "drag": args.drag}  # fmt: skip
-        with open(args.out, "w") as fh:
-            json.dump({**head, "rows": rows}, fh, separators=(",", ":"))
+        write_json(args.out, {**head, "rows": rows}, separators=(",", ":"))
     return 0
 
 

@@ -1,9 +1,10 @@
-"""The light-press rim probe (``pads_rim_probe.py``: az -0.25, drag 0.5) with our pads' Slide on MuJoCo C's puck
-support (``puck_support=polygon``, ``envs/puck_support.py``) beside FetchSlide-v4 from the same starts; per direction
-the first commanded offset that slipped and the puck's largest tilt.
+"""The light-press rim probe (``pads_rim_probe.py``: az -0.25, drag 0.5) with our pads' Slide on MJX's plane or, with
+``--support polygon``, on MuJoCo C's puck support (``puck_support=polygon``: the package at 56a0a5b, where it lives)
+beside FetchSlide-v4 from the same starts; per direction the first commanded offset that slipped and the puck's
+largest tilt.
 
     PYTHONPATH=. python experiments/results/2026-11-28/slide-pads/analysis/pads_rim_probe_polygon.py \
-        --out experiments/results/2026-11-28/slide-pads/analysis/rim_probe_light_press_polygon.json
+        --support polygon --out experiments/results/2026-11-28/slide-pads/analysis/rim_probe_light_press_polygon.json.gz
 
 ``--yaws``: the puck also starts turned about its axis by each of these angles (degrees) in both simulators. A
 turned cylinder is the same shape, but both colliders' choice of corners, decided by rounding, changes with it: the
@@ -116,16 +117,13 @@ def main(argv=None) -> int:
     p.add_argument("--offsets", default=OFFSETS)
     p.add_argument("--yaws", default="0", help="the puck's start turns about its axis (degrees), comma-separated")
     p.add_argument("--upright", action="store_true", help="both pucks start exactly upright")
-    p.add_argument("--support", default="polygon", help="our puck_support (mjx: MJX's plane-cylinder contact)")
+    p.add_argument("--support", default="mjx", help="our puck_support (mjx: MJX's plane-cylinder contact)")
     p.add_argument("--env-options", default="", help="options for our Slide over the probe's (comma-separated k=v)")
     p.add_argument("--out", required=True)
     args = p.parse_args(argv)
     global UPRIGHT
     UPRIGHT = args.upright
-    from splid_jax.common.values import parse_overrides
-
-    base = probe.OPTIONS + f",puck_support={args.support}"
-    overrides = {**parse_overrides(base), **parse_overrides(args.env_options)}
+    overrides = probe.task_options(args.support, args.env_options)
     options = ",".join(f"{k}={v}" for k, v in overrides.items())  # the later key wins
     import jax
 
@@ -151,8 +149,7 @@ def main(argv=None) -> int:
     result = {"env_options": options, "press": -0.25, "drag": 0.5, "upright": args.upright,
               "summary": {"ours": summary(rows, "ours"), "fetch": summary(rows, "fetch")}, "rows": rows}  # fmt: skip
     print(json.dumps(result["summary"], indent=1))
-    with open(args.out, "w") as fh:
-        json.dump(result, fh, indent=1)
+    probe.write_json(args.out, result, indent=1)
     return 0
 
 

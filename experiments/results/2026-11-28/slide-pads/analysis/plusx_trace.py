@@ -7,13 +7,12 @@ C's of its last substep; ``--substeps``: the reference's every substep in those 
 Answers why +x at 0.025 holds in ours where the reference slips.
 
     PYTHONPATH=. python experiments/results/2026-11-28/slide-pads/analysis/plusx_trace.py --dir +x --offset 0.025 \
-        --support mjx --out experiments/results/2026-11-28/slide-pads/analysis/plusx_trace_0025.json
+        --support mjx --out experiments/results/2026-11-28/slide-pads/analysis/plusx_trace_0025.json.gz
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 
@@ -151,12 +150,10 @@ def main(argv=None) -> int:
     p.add_argument("--out", required=True)
     args = p.parse_args(argv)
     import envs
-    from splid_jax.common.values import parse_overrides
     from splid_jax.reference.extra import import_reference
 
     import_reference()
-    base = probe.OPTIONS + f",puck_support={args.support}"
-    overrides = {**parse_overrides(base), **parse_overrides(args.env_options)}
+    overrides = probe.task_options(args.support, args.env_options)
     options = ",".join(f"{k}={v}" for k, v in overrides.items())  # the later key wins
     env = envs.make("slide", **overrides)
     u = np.asarray(probe.DIRS[args.dir])
@@ -172,8 +169,7 @@ def main(argv=None) -> int:
     for a, b in zip(out["fetch"], out["ours"], strict=True):
         print(a["k"], "| F tilt", a["tilt"], "pads", a["pads_mm"], "pp", a["pad_puck"], "tab", a["table"])
         print("   | O tilt", b["tilt"], "pads", b["pads_mm"], "pp", b["pad_puck"], "tab", b["table"], flush=True)
-    with open(args.out, "w") as fh:
-        json.dump(out, fh)
+    probe.write_json(args.out, out)
     return 0
 
 

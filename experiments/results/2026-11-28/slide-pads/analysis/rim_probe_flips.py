@@ -2,17 +2,22 @@
 over the turns, the first slip, how many slips flipped the puck over (tilt > 90 degrees) and the largest tilt of the
 runs that held and of all.
 
-    python rim_probe_flips.py rim_probe_light_press_polygon_yaws.json ...
+    python rim_probe_flips.py rim_probe_light_press_polygon_yaws.json.gz ...
 """
 
 from __future__ import annotations
 
 import json
+import os
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from pads_rim_probe import read_json  # noqa: E402
 
 
 def flips(path: str) -> dict:
-    rows = json.load(open(path))["rows"]
+    rows = read_json(path)["rows"]
     out = {}
     for side in ("ours", "fetch"):
         for d in sorted({r["dir"] for r in rows}):
