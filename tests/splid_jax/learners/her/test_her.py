@@ -293,12 +293,13 @@ def test_blocks_of_target_every_steps_equal_the_steps_one_at_a_time():
     blocked, losses = jax.jit(her.updates)(state, key)
     batches = jax.jit(lambda s, k: her.draw(s, k, her.n_updates))(state, key)
     step = jax.jit(lambda h, tr: her.train_step(h, (tr, her.td_targets(h, tr))))
+    move_targets = jax.jit(her._moved_targets)
     h, critic_losses = state, []
     for i in range(her.n_updates):
         h, step_losses = step(h, jax.tree_util.tree_map(lambda x, i=i: x[i], batches))
         critic_losses.append(float(step_losses["critic_loss"]))
         if (i + 1) % 3 == 0:
-            moved = jax.jit(her._moved_targets)(h)
+            moved = move_targets(h)
             h = h.replace(target_actor=moved.target_actor, target_critic=moved.target_critic)
     np.testing.assert_allclose(losses["critic_loss"], critic_losses, rtol=1e-5)
     for a, b in zip(jax.tree_util.tree_leaves(blocked), jax.tree_util.tree_leaves(h), strict=True):
