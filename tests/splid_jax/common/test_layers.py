@@ -1,6 +1,8 @@
 """The MLP's layers against flax's own: the same parameter tree, outputs and gradients, the per-feature
 gradients summed in two stages."""
 
+import functools
+
 import flax.linen as nn
 import jax
 import jax.numpy as jnp
@@ -41,16 +43,12 @@ def test_mlp_has_flax_layers_parameters_outputs_and_gradients():
     def loss(net, p, xs):
         return jnp.sum(jnp.sin(net.apply(p, xs)))
 
-    # one compiled program per network (op by op, each primitive would compile on its own)
-    ours_grad, ours_out = jax.jit(
-        lambda p, xs: (jax.vmap(jax.grad(lambda p, xs: loss(ours, p, xs)), in_axes=(None, 0))(p, xs), ours.apply(p, xs))
-    )(params, x)
-    theirs_grad, theirs_out = jax.jit(
-        lambda p, xs: (
-            jax.vmap(jax.grad(lambda p, xs: loss(theirs, p, xs)), in_axes=(None, 0))(p, xs),
-            theirs.apply(p, xs),
-        )
-    )(params, x)
+    @functools.partial(jax.jit, static_argnums=0)  # one program per network, not an operation at a time
+    def grads_and_outputs(net, p, xs):
+        return jax.vmap(jax.grad(lambda p, xs: loss(net, p, xs)), in_axes=(None, 0))(p, xs), net.apply(p, xs)
+
+    ours_grad, ours_out = grads_and_outputs(ours, params, x)
+    theirs_grad, theirs_out = grads_and_outputs(theirs, params, x)
     np.testing.assert_allclose(ours_out, theirs_out, rtol=1e-5, atol=1e-6)
     for a, b in zip(jax.tree_util.tree_leaves(ours_grad), jax.tree_util.tree_leaves(theirs_grad), strict=True):
         np.testing.assert_allclose(a, b, rtol=1e-4, atol=1e-5)
