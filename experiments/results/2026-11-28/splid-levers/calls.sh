@@ -192,3 +192,23 @@ arm 1 pnp-cand-0 --seed 0 &
 wait
 cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/f4.tgz -T - times.txt
 cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
+
+# ---- call g2 (4 H200s) ----
+# The cloning rate falling with the noise (--learning-rate-end, linear over sigma_anneal iterations): Push on the
+# tuning seeds 1000-1004 and fresh 7100-7104 (1, 0.3, 0.1 in one program each), PickAndPlace on tuning 1000-1004 and
+# fresh 7000-7004 (1, 0.2); one program per GPU. The choice is made on the tuning seeds alone.
+export NCCL_NVLS_ENABLE=0 PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=$PWD:/tmp/site
+W=/tmp/g2; mkdir -p $W/arms; T0=$(date +%s)
+nvidia-cuda-mps-control -d 2>/dev/null && echo mps >> $W/times.txt
+NG=$(nvidia-smi -L | wc -l); echo "gpus $NG" >> $W/times.txt
+C="--checkpoint-every 0 --compile-cache= --no-plot --seeds 5 --iterations 80"
+arm() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$(( g % NG )) timeout -k 10 $(( 545 - ($(date +%s) - T0) )) python3 -m splid_jax.sweep $C --run-dir $W/arms/$n "$@" > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+arm 0 push-lr-1000 --env push --seed 1000 --vary learning_rate_end=1,0.3,0.1 &
+arm 1 push-lr-7100 --env push --seed 7100 --vary learning_rate_end=1,0.3,0.1 &
+arm 2 pnp-lr-1000 --env pick_and_place --seed 1000 --vary learning_rate_end=1,0.2 &
+arm 3 pnp-lr-7000 --env pick_and_place --seed 7000 --vary learning_rate_end=1,0.2 &
+wait
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/g2.tgz -T - times.txt
+cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
