@@ -212,3 +212,27 @@ arm 3 pnp-lr-7000 --env pick_and_place --seed 7000 --vary learning_rate_end=1,0.
 wait
 cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/g2.tgz -T - times.txt
 cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
+
+# ---- call g3 (4 H200s) ----
+# Hindsight goals that reach the episode's desired goal cloned as that goal (--relabel stop-desired on Push,
+# hold-desired on PickAndPlace; a temporary relabelling), each beside the default in the same call under MPS:
+# tuning seeds 1000-1004 and fresh 7100-7104 (Push), 7000-7004 (PickAndPlace). The choice is made on the tuning seeds.
+export NCCL_NVLS_ENABLE=0 PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=$PWD:/tmp/site
+W=/tmp/g3; mkdir -p $W/arms; T0=$(date +%s)
+nvidia-cuda-mps-control -d 2>/dev/null && echo mps >> $W/times.txt
+NG=$(nvidia-smi -L | wc -l); echo "gpus $NG" >> $W/times.txt
+C="--checkpoint-every 0 --compile-cache= --no-plot --seeds 5 --iterations 80"
+arm() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$(( g % NG )) timeout -k 10 $(( 545 - ($(date +%s) - T0) )) python3 -m splid_jax.sweep $C --run-dir $W/arms/$n "$@" > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+arm 0 push-default-1000 --env push --seed 1000 &
+arm 0 push-desired-1000 --env push --seed 1000 --relabel stop-desired &
+arm 1 push-default-7100 --env push --seed 7100 &
+arm 1 push-desired-7100 --env push --seed 7100 --relabel stop-desired &
+arm 2 pnp-default-1000 --env pick_and_place --seed 1000 &
+arm 2 pnp-desired-1000 --env pick_and_place --seed 1000 --relabel hold-desired &
+arm 3 pnp-default-7000 --env pick_and_place --seed 7000 &
+arm 3 pnp-desired-7000 --env pick_and_place --seed 7000 --relabel hold-desired &
+wait
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/g3.tgz -T - times.txt
+cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 1 $f; done
