@@ -238,6 +238,16 @@ def strike(sim: Sim, episodes: int, seed: int = 0) -> dict:
     return slide_press_probes.strike_stats(records)
 
 
+def free(sim: Sim) -> dict:
+    """The light probe's diagonal actions with the puck 0.3 m aside and the pads kept in the air (no contact): per
+    control step the grip's distance (mm) from FetchSlide-v4's under the same actions."""
+    u = np.asarray(probe.DIRS["diag"])
+    acts = [(0, 0, 0, 0) if i == 4 else a for i, a in enumerate(probe.actions(u, -0.25, 0.5))]
+    xy = sim.home[:2] + 0.04 * u + np.array([0.0, 0.3])
+    ours, ref = sim.run(xy, acts), Reference().run(xy, acts)
+    return {"grip_from_reference_mm": (1000 * np.abs(ours[:, 0:3] - ref[:, 0:3]).max(axis=1)).round(2).tolist()}
+
+
 def summarise(paths: list[str]) -> None:
     """One markdown row per result file: first slip +x / diag and the slips per offset over the turns, the grip's
     height above the puck's centre and the drag per step (light press, held runs; the press at 0 and 0.01 behind the
@@ -266,6 +276,7 @@ def main(argv=None) -> int:
     p.add_argument("--yaws", default="0")
     p.add_argument("--no-rim", action="store_true")
     p.add_argument("--strike", type=int, default=0, metavar="N")
+    p.add_argument("--free", action="store_true", help="also the grip's path in the air against the reference's")
     p.add_argument("--timestep", type=float, default=None)
     p.add_argument("--substeps", type=int, default=None)
     p.add_argument("--table", choices=("plane", "box"), default="plane", help="box: the reference's table box")
@@ -287,6 +298,9 @@ def main(argv=None) -> int:
         print("rim", json.dumps(result["rim"]["summary"]), flush=True)
     result["press"] = press(sim)
     print("press", json.dumps(result["press"]), flush=True)
+    if args.free:
+        result["free"] = free(sim)
+        print("free", json.dumps(result["free"]), flush=True)
     if args.strike:
         result["strike"] = strike(sim, args.strike)
         print("strike", json.dumps(result["strike"]), flush=True)
