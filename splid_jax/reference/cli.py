@@ -16,7 +16,7 @@ from splid_jax.cli import Parser, flag_error
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.common.paths import unwritable
 from splid_jax.reference.episodes import summarise
-from splid_jax.reference.extra import EXTRA, REFERENCE_IDS, EvaluationError, import_reference
+from splid_jax.reference.extra import EXTRA, REFERENCE_IDS, EvaluationError, import_reference, release_notice, versions
 from splid_jax.reference.policy import evaluate, load_run, policy_act
 from splid_jax.reference.response import RESPONSE_KEYS, step_response
 from splid_jax.reference.tracing import compare_slots, split_by_final, traces
@@ -133,9 +133,13 @@ def main(argv: list[str] | None = None) -> int:
     except (EvaluationError, InvalidConfig, CheckpointError) as err:
         print(f"{p.prog}: error: {flag_error(err, p)}", file=sys.stderr)
         return 2
+    result["versions"] = versions()
     print(title + ":")
     print(_line("ours (MJX)", result["ours"]))
     print(_line(result["reference"], result["fetch"]))
+    notice = release_notice(result.get("task", ""), result["versions"]["mujoco"])
+    if notice:
+        print(notice)
     if a.traces:
         import envs
 

@@ -90,6 +90,40 @@ def fix_joint_type_asserts(mujoco_utils=None) -> bool:
     return True
 
 
+# The last mujoco release gymnasium-robotics 1.4.2 runs unpatched. FetchSlide-v4's finger-puck contact (MuJoCo's
+# box-cylinder collider) differs after it: its scripted strike succeeds 0.965 / 0.880 on 3.11.0 and 0.295 / 0.295 on
+# 3.17.0 (experiments/NOTES.md, "Slide with the reference's pads"); Push's and PickAndPlace's boxes are unaffected.
+UNPATCHED_MUJOCO = "3.11.0"
+
+
+def versions() -> dict:
+    """The releases the reference ran on, for the JSON beside its numbers."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    import mujoco
+
+    try:
+        robotics = version("gymnasium-robotics")
+    except PackageNotFoundError:
+        robotics = None
+    return {"mujoco": mujoco.__version__, "gymnasium_robotics": robotics}
+
+
+def _release(text: str) -> tuple[int, ...]:
+    return tuple(int(part) for part in text.split(".")[:3] if part.isdigit())
+
+
+def release_notice(task: str, mujoco_version: str) -> str | None:
+    """A line for a Slide evaluation whose reference ran on a MuJoCo newer than ``UNPATCHED_MUJOCO``."""
+    if task != "slide" or _release(mujoco_version) <= _release(UNPATCHED_MUJOCO):
+        return None
+    return (
+        f"note: FetchSlide-v4 ran on MuJoCo {mujoco_version}, whose finger-puck contact differs from that of "
+        f"{UNPATCHED_MUJOCO}, the last release gymnasium-robotics 1.4.2 supports (experiments/reference/"
+        "reference_side.py runs the reference alone in an environment of that release)"
+    )
+
+
 def reference_id(task: str) -> str:
     if task not in REFERENCE_IDS:
         raise EvaluationError(

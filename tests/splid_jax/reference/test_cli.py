@@ -5,6 +5,7 @@ import builtins
 import json
 
 import jax
+import mujoco
 import numpy as np
 import pytest
 
@@ -123,6 +124,8 @@ def test_evaluator_on_push_and_the_scripted_push_in_both_simulators(tmp_path, ca
     assert cli.main([str(run), "--reference", "--episodes", "2", "--out", str(tmp_path / "r.json")]) == 0
     got = json.loads((tmp_path / "r.json").read_text())
     assert got["reference"] == "FetchPush-v4" and got["fetch"]["episodes"] == 2
+    assert got["versions"]["mujoco"] == mujoco.__version__ and got["versions"]["gymnasium_robotics"] == "1.4.2"
+    assert "note:" not in capsys.readouterr().out  # the release notice is Slide's alone
     # the mapping: the scripted controller, fed each simulator's raw observation, pushes the cube home in both
     env = make_env("push", cholesky="library")
     act = jax.jit(scripted.push)

@@ -58,3 +58,9 @@ def test_fetch_push_resets_and_steps_with_the_fix():
     assert obs["observation"].shape == (25,) and obs["desired_goal"].shape == (3,)
     obs, *_ = env.step(np.zeros(4))
     env.close()
+
+
+def test_slide_on_a_mujoco_after_the_unpatched_release_is_noted():
+    assert "3.17.0" in extra.release_notice("slide", "3.17.0") and "3.11.0" in extra.release_notice("slide", "3.17.0")
+    assert extra.release_notice("slide", "3.11.0") is None and extra.release_notice("slide", "3.4.0") is None
+    assert extra.release_notice("push", "3.17.0") is None and extra.release_notice("slide", "3.12.1") is not None
