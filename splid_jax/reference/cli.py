@@ -70,6 +70,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also trace both simulators from the same starts and goals (distance to goal, object "
                    "speed, grip position per step) and the grip's response to a held action")  # fmt: skip
     p.add_argument("--overwrite", action="store_true", help="replace an --out or --traces file that already exists")
+    p.add_argument("--reference-python", default=None, metavar="PYTHON",
+                   help="run the reference side under this interpreter, whose environment holds the package, "
+                   "gymnasium-robotics and its own MuJoCo (FetchSlide-v4 plays differently on 3.11.0, the release "
+                   "gymnasium-robotics 1.4.2 supports, and on ours); our side stays in this process")  # fmt: skip
     return p
 
 
@@ -108,6 +112,11 @@ def main(argv: list[str] | None = None) -> int:
             raise EvaluationError(f"--seed {a.seed}: must be an integer in [0, 2**32)")
         if a.run_dir is not None and not os.path.isdir(a.run_dir):
             raise EvaluationError(f"{a.run_dir} is not a directory")
+        if a.reference_python is not None:
+            if a.scripted or a.traces:
+                raise EvaluationError("--reference-python: a run's evaluation alone (not with --scripted or --traces)")
+            if not (os.path.isfile(a.reference_python) and os.access(a.reference_python, os.X_OK)):
+                raise EvaluationError(f"--reference-python {a.reference_python}: not an executable file")
         out = a.out or (os.path.join(a.run_dir, "reference.json") if a.run_dir else f"scripted-{a.scripted}.json")
         for flag, path in (("--out", out), ("--traces", a.traces)):
             if path is not None and not os.path.isdir(_folder(path)):
@@ -123,7 +132,8 @@ def main(argv: list[str] | None = None) -> int:
         else:
             import_reference()  # a missing extra fails before the checkpoint is read
             loaded = load_run(a.run_dir, a.step, a.env_options, a.eval_subgoal_reach)
-            result = evaluate(a.run_dir, a.episodes, a.seed, loaded=loaded)
+            result = evaluate(a.run_dir, a.episodes, a.seed, env_options=a.env_options, loaded=loaded,
+                              reference_python=a.reference_python)  # fmt: skip
             what = f"{result['algo']} on {result['task']}, iteration {result['step']}"
             title = f"{a.run_dir} ({what}), {a.episodes} episodes each"
             if a.traces:
@@ -133,7 +143,7 @@ def main(argv: list[str] | None = None) -> int:
     except (EvaluationError, InvalidConfig, CheckpointError) as err:
         print(f"{p.prog}: error: {flag_error(err, p)}", file=sys.stderr)
         return 2
-    result["versions"] = versions()
+    result.setdefault("versions", versions())
     print(title + ":")
     print(_line("ours (MJX)", result["ours"]))
     print(_line(result["reference"], result["fetch"]))

@@ -119,8 +119,8 @@ def release_notice(task: str, mujoco_version: str) -> str | None:
         return None
     return (
         f"note: FetchSlide-v4 ran on MuJoCo {mujoco_version}, whose finger-puck contact differs from that of "
-        f"{UNPATCHED_MUJOCO}, the last release gymnasium-robotics 1.4.2 supports (experiments/reference/"
-        "reference_side.py runs the reference alone in an environment of that release)"
+        f"{UNPATCHED_MUJOCO}, the last release gymnasium-robotics 1.4.2 supports (--reference-python runs the "
+        "reference in an environment of that release)"
     )
 
 

@@ -6,12 +6,13 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import io
+import json
 import os
 
 import numpy as np
 
 from splid_jax.reference.episodes import run_reference, summarise
-from splid_jax.reference.extra import REFERENCE_IDS, EvaluationError, import_reference, reference_id
+from splid_jax.reference.extra import REFERENCE_IDS, EvaluationError, import_reference, reference_id, versions
 from splid_jax.rollout import sweep_member  # noqa: F401  (named in the package's index)
 
 
@@ -32,12 +33,13 @@ def restore_run(run_dir: str, step: int | None = None, cfg=None):
     return cfg, env, trainer, state, step
 
 
-def load_run(run_dir: str, step: int | None = None, env_options: str = "", subgoal_reach: float | None = None):
+def load_run(run_dir: str, step: int | None = None, env_options: str = "", subgoal_reach: float | None = None,
+             adapt=None):  # fmt: skip
     """(config, our task, the policy as the run's evaluations acted (``act(pstate, obs, goal)``, steered at
     subgoals where the run's ``eval_subgoal_reach`` says), its ``PolicyState``, step) of the run in ``run_dir``:
     a run of train, or a member of a sweep. ``env_options`` (``KEY=VALUE,...``) change our task's fields
     from the run's, e.g. ``table=box`` to put the reference's table edges in our task; ``subgoal_reach``
-    replaces the run's ``eval_subgoal_reach``."""
+    replaces the run's ``eval_subgoal_reach``; ``adapt(config) -> config`` changes the config last."""
     from splid_jax.common.subgoals import steered
     from splid_jax.rollout import load_config
 
@@ -48,6 +50,7 @@ def load_run(run_dir: str, step: int | None = None, env_options: str = "", subgo
         cfg = dataclasses.replace(cfg, env_options=",".join(filter(None, (cfg.env_options, env_options))))
     if subgoal_reach is not None:
         cfg = dataclasses.replace(cfg, eval_subgoal_reach=subgoal_reach)
+    cfg = cfg if adapt is None else adapt(cfg)
     reference_id(cfg.env)
     cfg, env, trainer, state, step = restore_run(run_dir, step, cfg)
     return cfg, env, steered(trainer.policy, env, cfg.eval_subgoal_reach), state.policy, step
@@ -61,10 +64,11 @@ def policy_act(policy, pstate):
 
 
 def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None = None, env_options: str = "",
-             loaded: tuple | None = None) -> dict:  # fmt: skip
+             loaded: tuple | None = None, reference_python: str | None = None) -> dict:  # fmt: skip
     """The run's policy in the reference (its own resets, seeds ``seed`` ...) and in our task (the
     project's evaluation draw: ``rollout.rollout`` from ``PRNGKey(seed)``), ``episodes`` each.
-    ``loaded``: what ``load_run`` gave, to load the checkpoint once."""
+    ``loaded``: what ``load_run`` gave, to load the checkpoint once. ``reference_python``: an interpreter
+    whose environment runs the reference side (``splid_jax.reference.side``), on its own MuJoCo."""
     import jax
 
     from splid_jax.rollout import rollout
@@ -75,7 +79,10 @@ def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None 
     succ = np.asarray(states.success[1:] & ~states.invalid[1:])
     dist = np.linalg.norm(np.asarray(states.achieved_goal[-1] - states.desired_goal[-1]), axis=-1)
     ours = summarise(succ.any(axis=0), succ[-1], dist)
-    ref = run_reference(cfg.env, policy_act(policy, pstate), episodes, seed).summary()
+    if reference_python:
+        ref, ran_on = reference_side(reference_python, run_dir, episodes, seed, int(step), env_options, cfg)
+    else:
+        ref, ran_on = run_reference(cfg.env, policy_act(policy, pstate), episodes, seed).summary(), versions()
     return {
         "run_dir": run_dir,
         "algo": cfg.algo,
@@ -87,4 +94,26 @@ def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None 
         "eval_subgoal_reach": cfg.eval_subgoal_reach,
         "ours": ours,
         "fetch": ref,
+        "versions": ran_on,
     }
+
+
+def reference_side(python: str, run_dir: str, episodes: int, seed: int, step: int, env_options: str, cfg):
+    """(the reference's summary, its versions) from ``python -m splid_jax.reference.side`` run by ``python``."""
+    import subprocess
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "side.json")
+        cmd = [python, "-m", "splid_jax.reference.side", run_dir, "--episodes", str(episodes), "--seed", str(seed),
+               "--step", str(step), "--env-options", env_options, "--out", out]  # fmt: skip
+        if cfg.eval_subgoal_reach is not None:
+            cmd += ["--eval-subgoal-reach", repr(float(cfg.eval_subgoal_reach))]
+        quiet = {"stdin": subprocess.DEVNULL, "stdout": subprocess.DEVNULL}
+        done = subprocess.run(cmd, stderr=subprocess.PIPE, text=True, **quiet)
+        if done.returncode != 0:
+            last = (done.stderr.strip().splitlines() or [f"exit code {done.returncode}"])[-1]
+            raise EvaluationError(f"--reference-python {python}: its reference side failed: {last}")
+        with open(out) as fh:
+            side = json.load(fh)
+    return side["fetch"], side["versions"]

@@ -3,6 +3,7 @@ the same starts in both simulators."""
 
 import builtins
 import json
+import sys
 
 import jax
 import mujoco
@@ -115,6 +116,20 @@ def test_evaluator_on_reach_writes_both_simulators_numbers_and_traces(tmp_path, 
     assert tr["ours_obs"].shape == tr["fetch_obs"].shape == (3, 51, 10)
     assert set(got["slots"]) >= {"grip x", "finger vel r"}
     assert tr["response_fetch_step"].shape == tr["response_ours_rest_step"].shape == (20, 3)
+    # the reference side under another interpreter (here this one) gives the same numbers
+    argv = [str(run), "--reference", "--episodes", "3", "--out", str(tmp_path / "o")]
+    assert cli.main([*argv, "--reference-python", sys.executable]) == 0
+    other = json.loads((tmp_path / "o").read_text())
+    assert other["fetch"] == got["fetch"] and other["ours"] == got["ours"] and other["versions"] == got["versions"]
+
+
+def test_a_reference_interpreter_that_cannot_run_is_one_line(tmp_path, capsys):
+    run = tmp_path / "run"
+    run.mkdir()
+    err = _error(capsys, [str(run), "--reference", "--reference-python", str(tmp_path / "nowhere")])
+    assert "--reference-python" in err and "not an executable file" in err
+    err = _error(capsys, ["--scripted", "reach", "--reference", "--reference-python", sys.executable])
+    assert "--reference-python" in err and "--scripted" in err
 
 
 @pytest.mark.slow

@@ -1,0 +1,50 @@
+"""``PYTHON -m splid_jax.reference.side RUN_DIR --out FILE.json``: the reference side of an evaluation alone, under the
+MuJoCo of the interpreter that runs it. ``python -m splid_jax.evaluate RUN --reference --reference-python PYTHON``
+calls it so: FetchSlide-v4 plays differently on the MuJoCo release gymnasium-robotics 1.4.2 supports (3.11.0) and on
+the one our tasks run on (``extra.UNPATCHED_MUJOCO``), so its reference can run in an environment of its own."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+
+
+def loadable(cfg):
+    """``cfg`` with a task this MuJoCo builds: the pads' contact is checked on the kernels' release alone, and a
+    policy of theirs takes the box fingers' inputs (nothing of our task is stepped here)."""
+    from envs.physics import kernels_checked
+    from splid_jax.common.values import parse_overrides
+
+    options = parse_overrides(cfg.env_options)
+    if options.get("finger") != "pads" or kernels_checked():
+        return cfg
+    options["finger"] = "box"
+    return dataclasses.replace(cfg, env_options=",".join(f"{k}={v}" for k, v in options.items()))
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m splid_jax.reference.side", description=__doc__.split("\n\n")[0])
+    p.add_argument("run_dir")
+    p.add_argument("--episodes", type=int, required=True)
+    p.add_argument("--seed", type=int, required=True)
+    p.add_argument("--step", type=int, required=True)
+    p.add_argument("--env-options", default="")
+    p.add_argument("--eval-subgoal-reach", type=float, default=None)
+    p.add_argument("--out", required=True)
+    a = p.parse_args(argv)
+    from splid_jax.reference.episodes import run_reference
+    from splid_jax.reference.extra import import_reference, versions
+    from splid_jax.reference.policy import load_run, policy_act
+
+    import_reference()
+    cfg, _, policy, pstate, _ = load_run(a.run_dir, a.step, a.env_options, a.eval_subgoal_reach, adapt=loadable)
+    fetch = run_reference(cfg.env, policy_act(policy, pstate), a.episodes, a.seed).summary()
+    with open(a.out, "w") as fh:
+        json.dump({"fetch": fetch, "versions": versions()}, fh)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
