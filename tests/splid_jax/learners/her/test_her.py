@@ -2,6 +2,7 @@
 one compilation, determinism, and learning well above a random policy."""
 
 import dataclasses
+import functools
 
 import jax
 import jax.numpy as jnp
@@ -263,17 +264,24 @@ def test_bfloat16_computes_the_hidden_layers_in_bfloat16_and_keeps_parameters_an
         HerConfig(compute_dtype="float16")
 
 
-def test_targets_move_every_target_every_steps_only_once_warm():
-    her = _her(
-        update_every=0, n_batches=10, target_every=5, warm_up=0, hidden=(8,), batch_size=8, buffer_transitions=500
-    )
-    state = jax.jit(her.init)(jax.random.PRNGKey(1))
+@functools.cache
+def blocked_her():
+    """A HER whose targets move every 3 of its 6 gradient steps, its start, the start with one batch of explored
+    episodes stored (warm) and with none (cold), and its jitted updates: one compile for both tests reading them."""
+    small = dict(hidden=(8,), batch_size=8, buffer_transitions=500)
+    her = _her(update_every=0, n_batches=6, target_every=3, warm_up=0, **small)
+    state = jax.jit(her.init)(jax.random.PRNGKey(1))  # compiled whole here and below: op by op is slower
     episodes, valid, _ = jax.jit(her.explore)(state.policy, jax.random.PRNGKey(2))
     insert = jax.jit(episode_buffer.buffer_insert)
     cold = state.replace(buffer=insert(state.buffer, episodes, valid[:0].any() & valid))
     warm = state.replace(buffer=insert(state.buffer, episodes, valid))
+    return her, cold, warm, jax.jit(her.updates)
+
+
+def test_targets_move_every_target_every_steps_only_once_warm():
+    _, cold, warm, updates = blocked_her()
     for start, moves in ((cold, False), (warm, True)):
-        after, _ = jax.jit(her.updates)(start, jax.random.PRNGKey(3))
+        after, _ = updates(start, jax.random.PRNGKey(3))
         leaf = lambda s: jax.tree_util.tree_leaves(s.target_critic)[-1]  # noqa: E731
         assert (not np.array_equal(leaf(after), leaf(start))) == moves
         assert (
@@ -284,13 +292,9 @@ def test_targets_move_every_target_every_steps_only_once_warm():
 def test_blocks_of_target_every_steps_equal_the_steps_one_at_a_time():
     # each block of target_every steps takes its TD targets in one pass: as if every step computed its own
     # from target networks that move after every target_every-th step
-    small = dict(hidden=(8,), batch_size=8, buffer_transitions=500)
-    her = _her(update_every=0, n_batches=6, target_every=3, warm_up=0, **small)
-    state = jax.jit(her.init)(jax.random.PRNGKey(1))  # compiled whole here and below: op by op is slower
-    episodes, valid, _ = jax.jit(her.explore)(state.policy, jax.random.PRNGKey(2))
-    state = state.replace(buffer=jax.jit(episode_buffer.buffer_insert)(state.buffer, episodes, valid))
+    her, _, state, updates = blocked_her()
     key = jax.random.PRNGKey(3)
-    blocked, losses = jax.jit(her.updates)(state, key)
+    blocked, losses = updates(state, key)
     batches = jax.jit(lambda s, k: her.draw(s, k, her.n_updates))(state, key)
     step = jax.jit(lambda h, tr: her.train_step(h, (tr, her.td_targets(h, tr))))
     move_targets = jax.jit(her._moved_targets)
