@@ -15,7 +15,11 @@ from splid_jax.learners.splid.trainer import Trainer
 from splid_jax.runtime import programs
 from splid_jax.runtime.signals import Signals
 
-CFG = dict(env="point", num_envs=8, iterations=4, eval_every=2, bc_steps=5, batch_size=32, eval_episodes=16)
+# small networks and buffers (SPLID's default buffer of 200,000 pairs and three layers of 64 compile seconds longer):
+# the split is the same at any size
+CFG = dict(env="point", num_envs=8, iterations=4, eval_every=2, bc_steps=4, batch_size=32, eval_episodes=16,
+           hidden=(16, 16), buffer_size=1000)  # fmt: skip
+HER_CFG = dict(batch_size=32, update_every=0, n_batches=2, hidden=(16, 16), buffer_transitions=2000)
 
 
 def strong(tree):  # as the host loop places state and settings
@@ -37,11 +41,7 @@ def two_chunks(learner, chunk):
 def test_training_and_report_as_two_programs_give_the_one_programs_chunk():
     for learner in (
         Trainer(envs.make("point"), TrainConfig(**CFG)),
-        HER(
-            envs.make("point"),
-            TrainConfig(**CFG, algo="her"),
-            HerConfig(update_every=0, n_batches=4, batch_size=32, hidden=(32, 32)),
-        ),
+        HER(envs.make("point"), TrainConfig(**{**CFG, "num_envs": 4}, algo="her"), HerConfig(**HER_CFG)),
     ):
         fns = programs.parts(learner, stacked=False)
         assert len(fns) == 2
