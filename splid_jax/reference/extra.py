@@ -90,9 +90,9 @@ def fix_joint_type_asserts(mujoco_utils=None) -> bool:
     return True
 
 
-# The last mujoco release gymnasium-robotics 1.4.2 runs unpatched. FetchSlide-v4's finger-puck contact (MuJoCo's
-# box-cylinder collider) differs after it: its scripted strike succeeds 0.965 / 0.880 on 3.11.0 and 0.295 / 0.295 on
-# 3.17.0 (experiments/NOTES.md, "Slide with the reference's pads"); Push's and PickAndPlace's boxes are unaffected.
+# The last mujoco release gymnasium-robotics 1.4.2 runs unpatched. FetchSlide-v4's puck (a cylinder: MuJoCo's convex
+# collider) plays differently after it (experiments/NOTES.md, "FetchSlide-v4 on two MuJoCo releases"); Push's and
+# PickAndPlace's boxes do not.
 UNPATCHED_MUJOCO = "3.11.0"
 
 
@@ -118,7 +118,7 @@ def release_notice(task: str, mujoco_version: str) -> str | None:
     if task != "slide" or _release(mujoco_version) <= _release(UNPATCHED_MUJOCO):
         return None
     return (
-        f"note: FetchSlide-v4 ran on MuJoCo {mujoco_version}, whose finger-puck contact differs from that of "
+        f"note: FetchSlide-v4 ran on MuJoCo {mujoco_version}, whose puck contacts differ from those of "
         f"{UNPATCHED_MUJOCO}, the last release gymnasium-robotics 1.4.2 supports (--reference-python runs the "
         "reference in an environment of that release)"
     )
