@@ -17,6 +17,7 @@ from envs.fetch import scripted  # noqa: E402
 from splid_jax.config import TrainConfig  # noqa: E402
 from splid_jax.learners.registry import make_algorithm  # noqa: E402
 from splid_jax.reference import cli, episodes  # noqa: E402
+from splid_jax.reference import side as reference_side  # noqa: E402
 from splid_jax.runtime import checkpoint  # noqa: E402
 from splid_jax.runtime.run_files import env_settings  # noqa: E402
 
@@ -116,11 +117,23 @@ def test_evaluator_on_reach_writes_both_simulators_numbers_and_traces(tmp_path, 
     assert tr["ours_obs"].shape == tr["fetch_obs"].shape == (3, 51, 10)
     assert set(got["slots"]) >= {"grip x", "finger vel r"}
     assert tr["response_fetch_step"].shape == tr["response_ours_rest_step"].shape == (20, 3)
-    # the reference side under another interpreter (here this one) gives the same numbers
+    # the reference side alone (what another interpreter runs) gives the same numbers
+    alone_argv = [str(run), "--episodes", "3", "--seed", "0", "--step", "0", "--out", str(tmp_path / "s")]
+    assert reference_side.main(alone_argv) == 0
+    alone = json.loads((tmp_path / "s").read_text())
+    assert alone["fetch"] == got["fetch"] and alone["versions"] == got["versions"]
+    # and the evaluator takes it from the interpreter it is given, with this run's settings
+    fake = tmp_path / "python"
+    fake.write_text(f"#!/bin/sh\necho \"$@\" > {tmp_path / 'argv'}\n"
+                    f"cp {tmp_path / 's'} \"$(echo \"$@\" | sed 's/.*--out \\([^ ]*\\).*/\\1/')\"\n")  # fmt: skip
+    fake.chmod(0o755)
     argv = [str(run), "--reference", "--episodes", "3", "--out", str(tmp_path / "o")]
-    assert cli.main([*argv, "--reference-python", sys.executable]) == 0
+    assert cli.main([*argv, "--reference-python", str(fake)]) == 0
     other = json.loads((tmp_path / "o").read_text())
     assert other["fetch"] == got["fetch"] and other["ours"] == got["ours"] and other["versions"] == got["versions"]
+    called = (tmp_path / "argv").read_text().split()
+    assert called[:2] == ["-m", "splid_jax.reference.side"] and called[2] == str(run)
+    assert called[called.index("--step") + 1] == "0" and called[called.index("--episodes") + 1] == "3"
 
 
 def test_a_reference_interpreter_that_cannot_run_is_one_line(tmp_path, capsys):
