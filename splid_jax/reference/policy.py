@@ -82,7 +82,7 @@ def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None 
     if reference_python:
         ref, ran_on = reference_side(reference_python, run_dir, episodes, seed, int(step), env_options, cfg)
     else:
-        ref, ran_on = run_reference(cfg.env, policy_act(policy, pstate), episodes, seed).summary(), versions()
+        ref, ran_on = reference_here(cfg, policy, pstate, episodes, seed)
     return {
         "run_dir": run_dir,
         "algo": cfg.algo,
@@ -96,6 +96,11 @@ def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None 
         "fetch": ref,
         "versions": ran_on,
     }
+
+
+def reference_here(cfg, policy, pstate, episodes: int, seed: int) -> tuple[dict, dict]:
+    """(the reference's summary, the releases it ran on) in this process."""
+    return run_reference(cfg.env, policy_act(policy, pstate), episodes, seed).summary(), versions()
 
 
 def reference_side(python: str, run_dir: str, episodes: int, seed: int, step: int, env_options: str, cfg):

@@ -15,13 +15,13 @@ def loadable(cfg):
     """``cfg`` with a task this MuJoCo builds: the pads' contact is checked on the kernels' release alone, and a
     policy of theirs takes the box fingers' inputs (nothing of our task is stepped here)."""
     from envs.physics import kernels_checked
-    from splid_jax.common.values import parse_overrides
+    from splid_jax.common.values import format_overrides, parse_overrides
 
     options = parse_overrides(cfg.env_options)
     if options.get("finger") != "pads" or kernels_checked():
         return cfg
     options["finger"] = "box"
-    return dataclasses.replace(cfg, env_options=",".join(f"{k}={v}" for k, v in options.items()))
+    return dataclasses.replace(cfg, env_options=format_overrides(options))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -34,15 +34,14 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--eval-subgoal-reach", type=float, default=None)
     p.add_argument("--out", required=True)
     a = p.parse_args(argv)
-    from splid_jax.reference.episodes import run_reference
-    from splid_jax.reference.extra import import_reference, versions
-    from splid_jax.reference.policy import load_run, policy_act
+    from splid_jax.reference.extra import import_reference
+    from splid_jax.reference.policy import load_run, reference_here
 
     import_reference()
     cfg, _, policy, pstate, _ = load_run(a.run_dir, a.step, a.env_options, a.eval_subgoal_reach, adapt=loadable)
-    fetch = run_reference(cfg.env, policy_act(policy, pstate), a.episodes, a.seed).summary()
+    fetch, ran_on = reference_here(cfg, policy, pstate, a.episodes, a.seed)
     with open(a.out, "w") as fh:
-        json.dump({"fetch": fetch, "versions": versions()}, fh)
+        json.dump({"fetch": fetch, "versions": ran_on}, fh)
     return 0
 
 
