@@ -236,3 +236,29 @@ arm 3 pnp-desired-7000 --env pick_and_place --seed 7000 --relabel hold-desired &
 wait
 cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/g3.tgz -T - times.txt
 cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 1 $f; done
+
+# ---- Call h1 (4 H200s, 2026-11-28): every SELECT verdict at the final step (temporary relabel stop-exact / hold-exact),
+# beside the default; GPU 3: Figure 3's paper-preset SPLID process alone on a GPU. 421.9 s of command time.
+# Every SELECT verdict at the final step (--relabel stop-exact on Push, hold-exact on PickAndPlace; temporary),
+# each beside the default in the same call under MPS: tuning seeds 1000-1004, fresh 7100-7104 (Push), 7000-7004 (PnP).
+# GPU 3: Figure 3's SPLID process (paper preset, 20,000 episodes) alone on a GPU, for the side-by-side figure's bound.
+export NCCL_NVLS_ENABLE=0 PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=$PWD:/tmp/site
+W=/tmp/h1; mkdir -p $W/arms; T0=$(date +%s)
+nvidia-cuda-mps-control -d 2>/dev/null && echo mps >> $W/times.txt
+NG=$(nvidia-smi -L | wc -l); echo "gpus $NG" >> $W/times.txt
+C="--checkpoint-every 0 --compile-cache= --no-plot --seeds 5"
+arm() { g=$1; n=$2; shift 2; CUDA_VISIBLE_DEVICES=$(( g % NG )) timeout -k 10 $(( 560 - ($(date +%s) - T0) )) python3 -m splid_jax.sweep $C --run-dir $W/arms/$n "$@" > $W/arms/$n.log 2>&1; echo "$n rc=$? $(( $(date +%s) - T0 ))s" >> $W/times.txt; }
+arm 0 push-default-1000 --env push --seed 1000 --iterations 80 &
+arm 0 push-exact-1000 --env push --seed 1000 --iterations 80 --relabel stop-exact &
+arm 0 push-default-7100 --env push --seed 7100 --iterations 80 &
+arm 0 push-exact-7100 --env push --seed 7100 --iterations 80 --relabel stop-exact &
+arm 1 pnp-default-1000 --env pick_and_place --seed 1000 --iterations 80 &
+arm 1 pnp-exact-1000 --env pick_and_place --seed 1000 --iterations 80 --relabel hold-exact &
+arm 2 pnp-default-7000 --env pick_and_place --seed 7000 --iterations 80 &
+arm 2 pnp-exact-7000 --env pick_and_place --seed 7000 --iterations 80 --relabel hold-exact &
+arm 3 fig3-splid-alone --env push --preset paper --seed 0 --iterations 400 --num-envs 50 &
+wait
+cd $W && find arms -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' \) -size -4M | tar czf $OUT/h1.tgz -T - times.txt
+cat $W/times.txt; for f in $W/arms/*.log; do echo "== $f"; tail -n 2 $f; done
