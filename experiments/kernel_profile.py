@@ -211,7 +211,7 @@ def main(argv=None) -> int:
     p.add_argument("--repeats", type=int, default=5, help="timed calls; the median is reported")
     p.add_argument("--top", type=int, default=25, help="kernels listed (default 25)")
     p.add_argument(
-        "--variant", type=parse_variant, default=("default", {}), help="task overrides, e.g. solver_loops=unrolled"
+        "--variant", type=parse_variant, default=("default", {}), help="task overrides, e.g. solver_loops=search"
     )
     p.add_argument("--out", type=Path, default=None, help="write the results as JSON here (and .md beside it)")
     args = p.parse_args(argv)

@@ -2,7 +2,7 @@
 being traced for, and the options that leave the kernels out when a GPU's compiler fails on one.
 
 The replacements are equal to MJX's own to float rounding (``tests/envs``, ``experiments/physics_equality.py``):
-the small dense Cholesky solves unrolled (``cholesky``, ``envs/small_cholesky.py``), the solver's loops written
+the small dense Cholesky solves unrolled (``cholesky``, ``envs/small_cholesky.py``), the solver's line search written
 out (``solver_loops``, ``envs/solver_loops.py``), the whole solve as one program per env (``solver_loops``
 ``fused``, ``envs/fused_solver.py``) and the box contacts likewise (``collision``, ``envs/fused_collision.py``),
 the last two Pallas kernels on a GPU. A model whose fingers are boxes against a cylinder gets MJX's missing
@@ -15,9 +15,9 @@ import jax
 from envs.settings import check, check_integer
 
 CHOLESKY = ("unrolled", "library")  # envs/small_cholesky.py, or jax.scipy.linalg's batched calls
-# MJX's solver loops, both written out, the line search alone written out, each of the last two on a GPU only, and
-# the whole solve as one program per env (envs/fused_solver.py), always or on a GPU only
-SOLVER_LOOPS = ("loops", "unrolled", "search", "auto", "gpu-search", "fused", "gpu-fused")
+# MJX's solver loops, its line search written out always or on a GPU only, and the whole solve as one program per
+# env (envs/fused_solver.py), always or on a GPU only
+SOLVER_LOOPS = ("loops", "search", "gpu-search", "fused", "gpu-fused")
 COLLISION = ("mjx", "fused", "gpu-fused")  # plane-box and box-box contacts: MJX's, or envs/fused_collision.py's
 KERNEL_WARPS = (1, 2, 4, 8)  # a Triton program's warps are a power of two
 KERNELS = ("fused", "gpu-fused")  # the choices above that run a part of the physics as a Pallas kernel
@@ -50,12 +50,10 @@ def mjx_with_kernels(task):
     from envs import box_cylinder, fused_collision, fused_solver, mjx_patch, small_cholesky, solver_loops
 
     backend = jax.default_backend()
-    newton, line_search = solver_loops.writes_out(task.solver_loops, backend)
     opts = dict(kernel=backend == "gpu", max_envs=task.kernel_envs, num_warps=task.kernel_warps)
     return mjx_patch.patched_mjx(
         cholesky=small_cholesky.UNROLLED if task.cholesky == "unrolled" else None,
-        while_loop=solver_loops.solver_while(task.iterations) if newton else None,
-        line_search=solver_loops.written_out_scan if line_search else None,
+        line_search=solver_loops.written_out_scan if solver_loops.writes_out(task.solver_loops, backend) else None,
         solve=fused_solver.fused(**opts) if runs_as_kernel(task.solver_loops, backend) else None,
         collide={**box_cylinder.groups_for(task.mj_model),
                  **(fused_collision.groups(**opts) if runs_as_kernel(task.collision, backend) else {})},

@@ -77,10 +77,9 @@ class _FetchTask(GoalEnv):
     finger: str = experimental("box")
     # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     cholesky: str = experimental("unrolled")
-    # MJX's Newton solver as its loops, written out (unrolled), its line search alone written out (search),
-    # or either on a GPU only (auto, gpu-search; envs/solver_loops.py), or the whole solve one program per env, a
-    # Pallas kernel on a GPU (fused; on a GPU only, MJX's loops on a CPU: gpu-fused; envs/fused_solver.py):
-    # equal to float rounding
+    # MJX's Newton solver as its loops, its line search written out (search), or that on a GPU only (gpu-search;
+    # envs/solver_loops.py), or the whole solve one program per env, a Pallas kernel on a GPU (fused; on a GPU
+    # only, MJX's loops on a CPU: gpu-fused; envs/fused_solver.py): equal to float rounding
     solver_loops: str = experimental("gpu-search", numerics_only=True)
     # the most envs in one batch that the physics kernels take, MJX's batched code above (0: any batch): one env
     # per program fills a GPU worse than batched operations at thousands of envs (envs/kernel_batch.py)

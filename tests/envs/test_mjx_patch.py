@@ -20,11 +20,12 @@ def _mjx_own():
 
 def test_every_replacement_holds_inside_the_block_alone():
     before = _mjx_own()
-    loop, solve, groups = solver_loops.solver_while(3), fused_solver.fused(), fused_collision.groups()
-    with patched_mjx(cholesky=small_cholesky.UNROLLED, while_loop=loop, line_search=solver_loops.written_out_scan,
-                     solve=solve, collide=groups):  # fmt: skip
+    solve, groups = fused_solver.fused(), fused_collision.groups()
+    with patched_mjx(cholesky=small_cholesky.UNROLLED, line_search=solver_loops.written_out_scan, solve=solve,
+                     collide=groups):  # fmt: skip
         assert (jsl.cho_factor, jsl.cho_solve) == small_cholesky.UNROLLED
-        assert jax.lax.while_loop is loop and mjx_solver._while_loop_scan is solver_loops.written_out_scan
+        assert mjx_solver._while_loop_scan is solver_loops.written_out_scan
+        assert jax.lax.while_loop is before[2]  # JAX's own loops are never replaced
         assert mjx_solver.solve is solve
         table = collision_driver._COLLISION_FUNC
         assert {k for k, f in table.items() if f is not before[5][k]} == set(groups)
