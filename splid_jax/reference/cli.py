@@ -15,11 +15,12 @@ import numpy as np
 from splid_jax.cli import Parser, flag_error
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.common.paths import unwritable
-from splid_jax.reference.episodes import summarise
+from splid_jax.reference.episodes import Episodes, run_ours, summarise
 from splid_jax.reference.extra import EXTRA, REFERENCE_IDS, EvaluationError, import_reference, release_notice, versions
+from splid_jax.reference.mapping import our_starts, save_starts
 from splid_jax.reference.policy import evaluate, load_run, policy_act
 from splid_jax.reference.response import RESPONSE_KEYS, step_response
-from splid_jax.reference.tracing import compare_slots, split_by_final, traces
+from splid_jax.reference.tracing import compare_slots, split_by_final, traces, traces_of
 from splid_jax.runtime.run_files import write_atomic
 
 
@@ -68,7 +69,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="default: RUN_DIR/reference.json (with --scripted: scripted-TASK.json)")  # fmt: skip
     p.add_argument("--traces", default=None, metavar="FILE.npz",
                    help="also trace both simulators from the same starts and goals (distance to goal, object "
-                   "speed, grip position per step) and the grip's response to a held action")  # fmt: skip
+                   "speed, grip position per step) and the grip's response to a held action (this process's "
+                   "MuJoCo; with --reference-python the reference's traces come from that interpreter's)")  # fmt: skip
     p.add_argument("--overwrite", action="store_true", help="replace an --out or --traces file that already exists")
     p.add_argument("--reference-python", default=None, metavar="PYTHON",
                    help="run the reference side under this interpreter, whose environment holds the package, "
@@ -96,6 +98,25 @@ def scripted(task: str, episodes: int, seed: int) -> tuple[dict, dict]:
     return result, tr
 
 
+def traced_elsewhere(a, loaded) -> tuple[dict, dict]:
+    """(result, traces) with the reference side under ``--reference-python``: our starts go to it as a file, its
+    episodes from them come back as one, and ours are run here from the same starts."""
+    import tempfile
+
+    import jax
+
+    cfg, env, policy, pstate, _ = loaded
+    starts = our_starts(env, jax.random.PRNGKey(a.seed), a.episodes)
+    with tempfile.TemporaryDirectory() as tmp:
+        paths = (os.path.join(tmp, "starts.npz"), os.path.join(tmp, "fetch.npz"))
+        save_starts(paths[0], starts)
+        result = evaluate(a.run_dir, a.episodes, a.seed, env_options=a.env_options, loaded=loaded,
+                          reference_python=a.reference_python, side_traces=paths)  # fmt: skip
+        ref = Episodes.load(paths[1])
+    ours = run_ours(env, lambda o, g: policy.act(pstate, o, g), starts["state"])
+    return result, traces_of(ours, ref, env.has_object)
+
+
 def main(argv: list[str] | None = None) -> int:
     from splid_jax.runtime.checkpoint import CheckpointError
 
@@ -113,8 +134,8 @@ def main(argv: list[str] | None = None) -> int:
         if a.run_dir is not None and not os.path.isdir(a.run_dir):
             raise EvaluationError(f"{a.run_dir} is not a directory")
         if a.reference_python is not None:
-            if a.scripted or a.traces:
-                raise EvaluationError("--reference-python: a run's evaluation alone (not with --scripted or --traces)")
+            if a.scripted:
+                raise EvaluationError("--reference-python: a run's evaluation alone (not with --scripted)")
             if not (os.path.isfile(a.reference_python) and os.access(a.reference_python, os.X_OK)):
                 raise EvaluationError(f"--reference-python {a.reference_python}: not an executable file")
         out = a.out or (os.path.join(a.run_dir, "reference.json") if a.run_dir else f"scripted-{a.scripted}.json")
@@ -132,11 +153,14 @@ def main(argv: list[str] | None = None) -> int:
         else:
             import_reference()  # a missing extra fails before the checkpoint is read
             loaded = load_run(a.run_dir, a.step, a.env_options, a.eval_subgoal_reach)
-            result = evaluate(a.run_dir, a.episodes, a.seed, env_options=a.env_options, loaded=loaded,
-                              reference_python=a.reference_python)  # fmt: skip
+            if a.traces and a.reference_python:
+                result, tr = traced_elsewhere(a, loaded)
+            else:
+                result = evaluate(a.run_dir, a.episodes, a.seed, env_options=a.env_options, loaded=loaded,
+                                  reference_python=a.reference_python)  # fmt: skip
             what = f"{result['algo']} on {result['task']}, iteration {result['step']}"
             title = f"{a.run_dir} ({what}), {a.episodes} episodes each"
-            if a.traces:
+            if a.traces and not a.reference_python:
                 cfg, env, policy, pstate, _ = loaded
                 pol = lambda o, g: policy.act(pstate, o, g)  # noqa: E731
                 tr = traces(env, cfg.env, pol, policy_act(policy, pstate), a.episodes, a.seed)

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from splid_jax.reference.extra import make_reference
-from splid_jax.reference.mapping import our_starts, reference_start
+from splid_jax.reference.mapping import our_starts, reference_start, shifted
 
 Z95 = 1.959963984540054  # the normal quantile of a two-sided 95 % interval
 
@@ -28,6 +28,15 @@ class Episodes:
 
     def summary(self) -> dict:
         return summarise(self.success.any(axis=1), self.success[:, -1], final_distance(self))
+
+    def save(self, path: str) -> None:
+        """Its arrays as an npz: the hand-off from a reference run in another interpreter."""
+        np.savez(path, dt=self.dt, **{k: getattr(self, k) for k in ("obs", "achieved", "goal", "success", "actions")})
+
+    @classmethod
+    def load(cls, path: str) -> Episodes:
+        with np.load(path) as f:
+            return cls(**{k: f[k] for k in ("obs", "achieved", "goal", "success", "actions")}, dt=float(f["dt"]))
 
 
 def final_distance(ep: Episodes) -> np.ndarray:
@@ -133,10 +142,16 @@ def matched_episodes(task_env, task: str, act_jax, act_np, episodes: int, seed: 
     them, the reference is put there after its own reset."""
     import jax
 
+    starts = our_starts(task_env, jax.random.PRNGKey(seed), episodes)
+    ours = run_ours(task_env, act_jax, starts["state"])
+    return ours, matched_reference(task_env, task, act_np, starts, seed)
+
+
+def matched_reference(task_env, task: str, act_np, starts: dict, seed: int) -> Episodes:
+    """The reference's episodes from ``starts`` (``our_starts``'s, our task's coordinates; ``state`` not needed),
+    moved into the reference's coordinates by the homes of its env reset with ``seed``."""
     probe = make_reference(task)
     probe.reset(seed=seed)
-    starts = our_starts(task_env, jax.random.PRNGKey(seed), episodes, probe)
+    there = shifted(starts, task_env, probe)
     probe.close()
-    ours = run_ours(task_env, act_jax, starts["state"])
-    ref = run_reference(task, act_np, episodes, seed, starts=starts)
-    return ours, ref
+    return run_reference(task, act_np, len(starts["goal"]), seed, starts=there)

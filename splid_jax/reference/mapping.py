@@ -47,9 +47,24 @@ def our_starts(env, key, episodes: int, reference_env=None):
     start = jax.vmap(env.reset)(jax.random.split(key, episodes))
     goal = np.asarray(start.desired_goal, np.float64)
     xy = np.asarray(start.achieved_goal[:, :2], np.float64) if env.has_object else None
-    if reference_env is not None:
-        shift = reference_shift(env, reference_env)
-        if env.has_object:
-            xy = xy + shift[:2]
-        goal = goal + shift
-    return {"state": start, "object_xy": xy, "goal": goal}
+    starts = {"state": start, "object_xy": xy, "goal": goal}
+    return starts if reference_env is None else shifted(starts, env, reference_env)
+
+
+def shifted(starts: dict, env, reference_env) -> dict:
+    """``our_starts``'s starts, given in our task's coordinates, moved into those of the reset ``reference_env``."""
+    shift = reference_shift(env.evaluation_task(), reference_env)
+    xy = None if starts["object_xy"] is None else starts["object_xy"] + shift[:2]
+    return {**starts, "object_xy": xy, "goal": starts["goal"] + shift}
+
+
+def save_starts(path: str, starts: dict) -> None:
+    """The object x-y and goals of ``starts`` (our task's coordinates) as an npz, for a reference run elsewhere."""
+    xy = {} if starts["object_xy"] is None else {"object_xy": starts["object_xy"]}
+    np.savez(path, goal=starts["goal"], **xy)
+
+
+def load_starts(path: str) -> dict:
+    """What ``save_starts`` wrote: ``object_xy`` (None for Reach) and ``goal``, our task's coordinates."""
+    with np.load(path) as f:
+        return {"object_xy": f["object_xy"] if "object_xy" in f else None, "goal": f["goal"]}

@@ -64,11 +64,13 @@ def policy_act(policy, pstate):
 
 
 def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None = None, env_options: str = "",
-             loaded: tuple | None = None, reference_python: str | None = None) -> dict:  # fmt: skip
+             loaded: tuple | None = None, reference_python: str | None = None,
+             side_traces: tuple[str, str] | None = None) -> dict:  # fmt: skip
     """The run's policy in the reference (its own resets, seeds ``seed`` ...) and in our task (the
     project's evaluation draw: ``rollout.rollout`` from ``PRNGKey(seed)``), ``episodes`` each.
     ``loaded``: what ``load_run`` gave, to load the checkpoint once. ``reference_python``: an interpreter
-    whose environment runs the reference side (``splid_jax.reference.side``), on its own MuJoCo."""
+    whose environment runs the reference side (``splid_jax.reference.side``), on its own MuJoCo; ``side_traces``
+    (starts npz, episodes npz): that side also runs the reference from the starts and writes its episodes."""
     import jax
 
     from splid_jax.rollout import rollout
@@ -80,7 +82,8 @@ def evaluate(run_dir: str, episodes: int = 300, seed: int = 0, step: int | None 
     dist = np.linalg.norm(np.asarray(states.achieved_goal[-1] - states.desired_goal[-1]), axis=-1)
     ours = summarise(succ.any(axis=0), succ[-1], dist)
     if reference_python:
-        ref, ran_on = reference_side(reference_python, run_dir, episodes, seed, int(step), env_options, cfg)
+        ref, ran_on = reference_side(reference_python, run_dir, episodes, seed, int(step), env_options, cfg,
+                                     side_traces)  # fmt: skip
     else:
         ref, ran_on = reference_here(cfg, policy, pstate, episodes, seed)
     return {
@@ -103,7 +106,8 @@ def reference_here(cfg, policy, pstate, episodes: int, seed: int) -> tuple[dict,
     return run_reference(cfg.env, policy_act(policy, pstate), episodes, seed).summary(), versions()
 
 
-def reference_side(python: str, run_dir: str, episodes: int, seed: int, step: int, env_options: str, cfg):
+def reference_side(python: str, run_dir: str, episodes: int, seed: int, step: int, env_options: str, cfg,
+                   side_traces: tuple[str, str] | None = None):  # fmt: skip
     """(the reference's summary, its versions) from ``python -m splid_jax.reference.side`` run by ``python``."""
     import subprocess
     import tempfile
@@ -114,6 +118,8 @@ def reference_side(python: str, run_dir: str, episodes: int, seed: int, step: in
                "--step", str(step), "--env-options", env_options, "--out", out]  # fmt: skip
         if cfg.eval_subgoal_reach is not None:
             cmd += ["--eval-subgoal-reach", repr(float(cfg.eval_subgoal_reach))]
+        if side_traces is not None:
+            cmd += ["--starts", side_traces[0], "--traces", side_traces[1]]
         quiet = {"stdin": subprocess.DEVNULL, "stdout": subprocess.DEVNULL}
         done = subprocess.run(cmd, stderr=subprocess.PIPE, text=True, **quiet)
         if done.returncode != 0:

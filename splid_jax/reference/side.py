@@ -33,13 +33,20 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--env-options", default="")
     p.add_argument("--eval-subgoal-reach", type=float, default=None)
     p.add_argument("--out", required=True)
+    p.add_argument("--starts", default=None, help="an npz of mapping.save_starts: also run the reference from them")
+    p.add_argument("--traces", default=None, help="where those episodes go (Episodes.save), with --starts")
     a = p.parse_args(argv)
+    from splid_jax.reference.episodes import matched_reference
     from splid_jax.reference.extra import import_reference
-    from splid_jax.reference.policy import load_run, reference_here
+    from splid_jax.reference.mapping import load_starts
+    from splid_jax.reference.policy import load_run, policy_act, reference_here
 
     import_reference()
-    cfg, _, policy, pstate, _ = load_run(a.run_dir, a.step, a.env_options, a.eval_subgoal_reach, adapt=loadable)
+    cfg, env, policy, pstate, _ = load_run(a.run_dir, a.step, a.env_options, a.eval_subgoal_reach, adapt=loadable)
     fetch, ran_on = reference_here(cfg, policy, pstate, a.episodes, a.seed)
+    if a.starts:
+        act = policy_act(policy, pstate)
+        matched_reference(env, cfg.env, act, load_starts(a.starts), a.seed).save(a.traces)
     with open(a.out, "w") as fh:
         json.dump({"fetch": fetch, "versions": ran_on}, fh)
     return 0

@@ -9,14 +9,15 @@ from splid_jax.reference.episodes import Episodes, matched_episodes
 
 
 def trace_arrays(ep: Episodes, has_object: bool) -> dict:
-    """Per step (T + 1): achieved-goal-to-goal distance, object speed (m/s; 0 for Reach), grip position."""
+    """Per step (T + 1): achieved-goal-to-goal distance, object speed (m/s; 0 for Reach), grip position; and the
+    actions taken (T)."""
     dist = np.linalg.norm(ep.achieved - ep.goal[:, None], axis=-1)
     grip = ep.obs[..., 0:3]
     if has_object:
         speed = np.linalg.norm(ep.obs[..., 14:17] + ep.obs[..., 20:23], axis=-1) / ep.dt
     else:
         speed = np.zeros(dist.shape)
-    return {"distance": dist, "object_speed": speed, "grip": grip, "success": ep.success}
+    return {"distance": dist, "object_speed": speed, "grip": grip, "success": ep.success, "actions": ep.actions}
 
 
 SLOTS = {
@@ -46,9 +47,14 @@ def traces(task_env, task: str, act_jax, act_np, episodes: int, seed: int) -> di
     """Traces of both simulators from the same starts, keys ``ours_*`` and ``fetch_*`` ([E, T + 1]
     or [E, T + 1, 3]; ``*_success`` [E, T]) and the start goals."""
     ours, ref = matched_episodes(task_env, task, act_jax, act_np, episodes, seed)
+    return traces_of(ours, ref, task_env.has_object)
+
+
+def traces_of(ours: Episodes, ref: Episodes, has_object: bool) -> dict:
+    """``traces``'s arrays of matched episodes, however the reference's were run."""
     out = {"goal_ours": ours.goal, "goal_fetch": ref.goal, "ours_obs": ours.obs, "fetch_obs": ref.obs}
     for name, ep in (("ours", ours), ("fetch", ref)):
-        for k, v in trace_arrays(ep, task_env.has_object).items():
+        for k, v in trace_arrays(ep, has_object).items():
             out[f"{name}_{k}"] = v
     return out
 

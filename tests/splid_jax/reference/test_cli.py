@@ -16,7 +16,7 @@ from envs import make as make_env  # noqa: E402
 from envs.fetch import scripted  # noqa: E402
 from splid_jax.config import TrainConfig  # noqa: E402
 from splid_jax.learners.registry import make_algorithm  # noqa: E402
-from splid_jax.reference import cli, episodes  # noqa: E402
+from splid_jax.reference import cli, episodes, mapping, policy  # noqa: E402
 from splid_jax.reference import side as reference_side  # noqa: E402
 from splid_jax.runtime import checkpoint  # noqa: E402
 from splid_jax.runtime.run_files import env_settings  # noqa: E402
@@ -134,6 +134,23 @@ def test_evaluator_on_reach_writes_both_simulators_numbers_and_traces(tmp_path, 
     called = (tmp_path / "argv").read_text().split()
     assert called[:2] == ["-m", "splid_jax.reference.side"] and called[2] == str(run)
     assert called[called.index("--step") + 1] == "0" and called[called.index("--episodes") + 1] == "3"
+    # traced there: our starts go to that interpreter as a file and its episodes from them come back as one
+    env = policy.load_run(str(run))[1]
+    mapping.save_starts(tmp_path / "starts.npz", mapping.our_starts(env, jax.random.PRNGKey(0), 3))
+    there = ["--starts", str(tmp_path / "starts.npz"), "--traces", str(tmp_path / "side.npz")]
+    assert reference_side.main([*alone_argv, *there]) == 0
+    fake.write_text(f"#!{sys.executable}\nimport shutil, sys\na = sys.argv\n"
+                    f"shutil.copy(a[a.index('--starts') + 1], {str(tmp_path / 'sent.npz')!r})\n"
+                    f"shutil.copy({str(tmp_path / 'side.npz')!r}, a[a.index('--traces') + 1])\n"
+                    f"shutil.copy({str(tmp_path / 's')!r}, a[a.index('--out') + 1])\n")  # fmt: skip
+    traced = [*argv, "--overwrite", "--reference-python", str(fake), "--traces", str(tmp_path / "t2.npz")]
+    assert cli.main(traced) == 0
+    sent = mapping.load_starts(tmp_path / "sent.npz")
+    np.testing.assert_array_equal(sent["goal"], mapping.load_starts(tmp_path / "starts.npz")["goal"])
+    here, elsewhere = np.load(tmp_path / "t.npz"), np.load(tmp_path / "t2.npz")
+    assert set(here.files) == set(elsewhere.files) and "fetch_actions" in here.files
+    for key in here.files:  # the same starts, episodes and traces as when the reference ran in this process
+        np.testing.assert_array_equal(here[key], elsewhere[key], err_msg=key)
 
 
 def test_a_reference_interpreter_that_cannot_run_is_one_line(tmp_path, capsys):
