@@ -161,6 +161,7 @@ def mjcf(
     drive: str = "pd",
     finger_table: float = 0.0,
     finger_drive: str = "reference",
+    pad_friction: float = 1.0,
 ) -> str:
     """The MJCF text of task ``kind`` (one of ``KINDS``); ``table`` is the table's collision shape
     (``tables_for(kind)``), ``finger`` the closed finger block's (``fingers_for(kind)``).
@@ -257,8 +258,8 @@ def mjcf(
     <pair geom1="finger_l" geom2="object" condim="4" friction="1 1 0.005 0.0001 0.0001"/>
     <pair geom1="finger_r" geom2="object" condim="4" friction="1 1 0.005 0.0001 0.0001"/>"""
     elif slide:
-        fingers, finger_pairs, table_fingers = slide_fingers.mjcf(finger, below, finger_table,
-                                                                  f'{nograv} rgba="0.3 0.3 0.3 1"')  # fmt: skip
+        look = f'{nograv} rgba="0.3 0.3 0.3 1"'
+        fingers, finger_pairs, table_fingers = slide_fingers.mjcf(finger, below, finger_table, look, pad_friction)
         finger_act = ""
     else:
         shape = {

@@ -25,7 +25,7 @@ PAD_HALF = (0.0135, 0.007, 0.0385)
 PAD_CENTERS = ((-0.001, 0.008, 0.02), (-0.001, -0.0095, 0.02))
 # the pad-puck pair as MuJoCo mixes a pad (condim 4, friction 1 0.05 0.01, margin 0.001, solref 0.01 1, solimp
 # 0.99 0.99 0.01) with the puck (condim 3, friction 0.1 0.005 0.0001, the default solref and solimp)
-PAD_PUCK_CONTACT = ('condim="4" friction="1 1 0.05 0.01 0.01" margin="0.001" solref="0.015 1" '
+PAD_PUCK_CONTACT = ('condim="4" friction="{mu} {mu} 0.05 0.01 0.01" margin="0.001" solref="0.015 1" '
                     'solimp="0.945 0.97 0.0055 0.5 2"')  # fmt: skip
 
 
@@ -33,10 +33,13 @@ def _fmt(*xs: float) -> str:
     return " ".join(f"{x:.6g}" for x in xs)
 
 
-def mjcf(finger: str, below: float, finger_table: float, visual: str) -> tuple[str, str, tuple[str, ...]]:
+def mjcf(
+    finger: str, below: float, finger_table: float, visual: str, pad_friction: float = 1.0
+) -> tuple[str, str, tuple[str, ...]]:
     """(the gripper body's finger geoms, the finger-puck contact pairs, the names of the geoms that may touch the
     table) for ``finger``; ``below``: how far the fingertips reach below the grip site ("box"), ``finger_table``
-    whether they touch the table, ``visual`` the geoms' shared attributes."""
+    whether they touch the table, ``visual`` the geoms' shared attributes, ``pad_friction`` the pads' sliding
+    friction on the puck (the reference's is 1)."""
     if finger == "pads":
         (hx, hy, hz), names = PAD_HALF, ("pad_r", "pad_l")
         geoms = "".join(
@@ -44,8 +47,9 @@ def mjcf(finger: str, below: float, finger_table: float, visual: str) -> tuple[s
       <geom name="{n}" type="box" size="{_fmt(hx, hy, hz)}" pos="{_fmt(*c)}" mass="0.001" {visual}/>"""
             for n, c in zip(names, PAD_CENTERS, strict=True)
         )
+        contact = PAD_PUCK_CONTACT.format(mu=f"{pad_friction:.6g}")
         pairs = "".join(f"""
-    <pair geom1="{n}" geom2="object" {PAD_PUCK_CONTACT}/>""" for n in names)  # fmt: skip
+    <pair geom1="{n}" geom2="object" {contact}/>""" for n in names)  # fmt: skip
         return geoms, pairs, names
     # Closed fingers drawn as a block; they strike the puck with four round corner tips. With a finger-table
     # contact the block and the tips reach the reference's fingertips' depth, the tips' bottoms level with

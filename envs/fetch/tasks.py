@@ -108,6 +108,9 @@ class _FetchTask(GoalEnv):
     # The gripper's mass in kg (0: the task's, models.mjcf): how hard the weld drive presses (Slide's pads sink
     # into the puck as deep as the reference's at 22 kg, its arm's effective mass along z at the grip site)
     gripper_mass: float = experimental(0.0, recorded_when_set=True)
+    # The Slide pads' sliding friction on the puck (finger=pads; the reference's 1): how readily a pressed puck
+    # slips out from under them (NOTES, "Where Slide's episodes part from the reference")
+    pad_friction: float = experimental(1.0, recorded_when_set=True)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -148,6 +151,8 @@ class _FetchTask(GoalEnv):
         check(0 <= self.floor_clearance <= 0.1, f"{n}.floor_clearance", self.floor_clearance, "in [0, 0.1] m")
         check(0 <= self.finger_table <= 2, f"{n}.finger_table", self.finger_table, "in [0, 2]")
         check(0 <= self.gripper_mass <= 100, f"{n}.gripper_mass", self.gripper_mass, "in [0, 100] kg (0: the task's)")
+        ok = self.pad_friction == 1 or (0 < self.pad_friction <= 2 and self.finger == "pads")
+        check(ok, f"{n}.pad_friction", self.pad_friction, "in (0, 2] with finger=pads, else 1")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -178,6 +183,7 @@ class _FetchTask(GoalEnv):
             drive=str(self.drive),
             finger_table=float(self.finger_table),
             **({"gripper_mass": float(self.gripper_mass)} if self.gripper_mass else {}),
+            **({"pad_friction": float(self.pad_friction)} if self.pad_friction != 1 else {}),
         )
 
     @property

@@ -21,6 +21,7 @@ def loadable(cfg):
     if options.get("finger") != "pads" or kernels_checked():
         return cfg
     options["finger"] = "box"
+    options.pop("pad_friction", None)  # the pads' own
     return dataclasses.replace(cfg, env_options=format_overrides(options))
 
 

@@ -67,3 +67,12 @@ def test_scripted_strike_succeeds_with_the_reference_pads(fetch):
     assert reached.mean() >= 0.75, reached  # 0.906 of 64 episodes (the reference: 0.965), see the results file
     obs = np.asarray(traj.obs)
     assert np.abs(obs[..., 3:5] - np.asarray(s0.obs)[None, :, 3:5]).max() > 0.1  # the pucks were struck
+
+
+def test_pad_friction_sets_the_pads_pairs_alone_and_needs_the_pads():
+    m = envs.make("slide", finger="pads", pad_friction=0.2)
+    assert m.settings()["pad_friction"] == 0.2 and "pad_friction" not in envs.make("slide", finger="pads").settings()
+    pads = [i for i in range(m.mj_model.npair) if m.mj_model.geom(m.mj_model.pair_geom1[i]).name.startswith("pad_")]
+    assert len(pads) == 2 and np.allclose(m.mj_model.pair_friction[pads, :2], 0.2)
+    with pytest.raises(ValueError, match="pad_friction"):
+        envs.make("slide", pad_friction=0.2)  # the round tips have no pads
