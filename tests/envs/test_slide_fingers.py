@@ -76,3 +76,5 @@ def test_pad_friction_sets_the_pads_pairs_alone_and_needs_the_pads():
     assert len(pads) == 2 and np.allclose(m.mj_model.pair_friction[pads, :2], 0.2)
     with pytest.raises(ValueError, match="pad_friction"):
         envs.make("slide", pad_friction=0.2)  # the round tips have no pads
+    with pytest.raises(ValueError, match="pad_friction"):
+        envs.make("push", finger="pads", pad_friction=0.2)  # Push's pads are its finger block, not Slide's pairs
