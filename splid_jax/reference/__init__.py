@@ -85,6 +85,7 @@ _HOMES = {
         "final_distance",
         "matched_episodes",
         "matched_reference",
+        "ours_from_starts",
         "run_ours",
         "run_reference",
         "summarise",

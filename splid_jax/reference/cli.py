@@ -15,9 +15,9 @@ import numpy as np
 from splid_jax.cli import Parser, flag_error
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.common.paths import unwritable
-from splid_jax.reference.episodes import Episodes, run_ours, summarise
+from splid_jax.reference.episodes import Episodes, ours_from_starts, summarise
 from splid_jax.reference.extra import EXTRA, REFERENCE_IDS, EvaluationError, import_reference, release_notice, versions
-from splid_jax.reference.mapping import our_starts, save_starts
+from splid_jax.reference.mapping import save_starts
 from splid_jax.reference.policy import evaluate, load_run, policy_act
 from splid_jax.reference.response import RESPONSE_KEYS, step_response
 from splid_jax.reference.tracing import compare_slots, split_by_final, traces, traces_of
@@ -103,17 +103,14 @@ def traced_elsewhere(a, loaded) -> tuple[dict, dict]:
     episodes from them come back as one, and ours are run here from the same starts."""
     import tempfile
 
-    import jax
-
     cfg, env, policy, pstate, _ = loaded
-    starts = our_starts(env, jax.random.PRNGKey(a.seed), a.episodes)
+    starts, ours = ours_from_starts(env, lambda o, g: policy.act(pstate, o, g), a.episodes, a.seed)
     with tempfile.TemporaryDirectory() as tmp:
         paths = (os.path.join(tmp, "starts.npz"), os.path.join(tmp, "fetch.npz"))
         save_starts(paths[0], starts)
         result = evaluate(a.run_dir, a.episodes, a.seed, env_options=a.env_options, loaded=loaded,
                           reference_python=a.reference_python, side_traces=paths)  # fmt: skip
         ref = Episodes.load(paths[1])
-    ours = run_ours(env, lambda o, g: policy.act(pstate, o, g), starts["state"])
     return result, traces_of(ours, ref, env.has_object)
 
 

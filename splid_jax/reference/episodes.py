@@ -137,13 +137,19 @@ def summarise(any_step, final_step, distance) -> dict:
     return out
 
 
-def matched_episodes(task_env, task: str, act_jax, act_np, episodes: int, seed: int):
-    """(ours, reference) ``Episodes`` from the same starts and goals: our task's ``reset`` draws
-    them, the reference is put there after its own reset."""
+def ours_from_starts(task_env, act_jax, episodes: int, seed: int) -> tuple[dict, Episodes]:
+    """(``our_starts``'s starts drawn with ``seed``, our ``Episodes`` from them): the side of a matched pair that
+    runs here, whichever interpreter runs the reference's."""
     import jax
 
     starts = our_starts(task_env, jax.random.PRNGKey(seed), episodes)
-    ours = run_ours(task_env, act_jax, starts["state"])
+    return starts, run_ours(task_env, act_jax, starts["state"])
+
+
+def matched_episodes(task_env, task: str, act_jax, act_np, episodes: int, seed: int):
+    """(ours, reference) ``Episodes`` from the same starts and goals: our task's ``reset`` draws
+    them, the reference is put there after its own reset."""
+    starts, ours = ours_from_starts(task_env, act_jax, episodes, seed)
     return ours, matched_reference(task_env, task, act_np, starts, seed)
 
 
