@@ -21,7 +21,8 @@ def loadable(cfg):
     if options.get("finger") != "pads" or kernels_checked():
         return cfg
     options["finger"] = "box"
-    options.pop("pad_friction", None)  # the pads' own
+    for own in ("pad_friction", "pad_top_friction"):  # the pads' own
+        options.pop(own, None)
     return dataclasses.replace(cfg, env_options=format_overrides(options))
 
 
