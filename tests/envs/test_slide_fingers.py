@@ -3,9 +3,6 @@ registered only while MJX builds and steps such a model, and the scripted strike
 
 from __future__ import annotations
 
-import functools
-
-import jax
 import jax.numpy as jnp
 import mujoco
 import numpy as np
@@ -14,8 +11,8 @@ from mujoco.mjx._src import collision_driver
 from mujoco.mjx._src.types import GeomType
 
 import envs
-from envs import box_cylinder
 from envs.fetch import models, slide_fingers
+from tests.envs.test_box_cylinder import _ours as box_cylinder_program  # its compiled program, shared
 
 # the Slide whose press matches the reference's (experiments/reference/results/slide-pads.md)
 PADS = {"finger": "pads", "finger_table": 1.0, "drive": "weld", "gripper_mass": 22.0}
@@ -125,17 +122,12 @@ def _live(m, name, pad_pos):
     puck upright at the origin) against the puck's geom ``name``."""
     g, eye = m.geom(name), np.eye(3, dtype=np.float32)
     args = (g.pos, eye, g.size[:2], pad_pos, eye, slide_fingers.PAD_HALF)
-    dist = np.asarray(_collide()(*(jnp.asarray(x, jnp.float32) for x in args))[0])
+    dist = np.asarray(box_cylinder_program()(*(jnp.asarray(x, jnp.float32) for x in args))[0])
     return dist[dist < m.pair_margin[_pair(m, "pad_r", name)]]
 
 
 def _pair(m, g1, g2):
     return next(i for i in range(m.npair) if (m.geom(m.pair_geom1[i]).name, m.geom(m.pair_geom2[i]).name) == (g1, g2))
-
-
-@functools.cache
-def _collide():
-    return jax.jit(box_cylinder.box_cylinder)
 
 
 def test_a_press_meets_the_cap_alone_and_a_strike_the_side_alone():
