@@ -14,7 +14,7 @@ S="python3 -m splid_jax.sweep --env slide --checkpoint-every 0 --compile-cache= 
 H="$S --algo her --iterations 375 --num-envs 16 --her-compute-dtype bfloat16"  # 375 x 16 = 6,000 episodes
 P="$S --iterations 30"  # 30 x 512 = 15,360 episodes
 export XLA_FLAGS=--xla_gpu_enable_triton_gemm=false
-STOP_HER=${STOP_HER:-455} STOP_SPLID=${STOP_SPLID:-455}  # then export (at most 45 s) and pack: the whole within 520 s
+STOP_HER=${STOP_HER:-450} STOP_SPLID=${STOP_SPLID:-450}  # then export (at most 45 s) and pack: the whole within 520 s
 left() { echo $(( $1 - ($(date +%s) - T0) )); }
 arm() {  # name stop command...
   local n=$1 stop=$2; shift 2
