@@ -2,7 +2,7 @@
 # the side keeps 1): HER (mrl) at 16 envs, bf16, cuBLAS products, to 6,000 episodes, and SPLID's default to 15,360
 # episodes, fresh seeds 9200-9202 (chose nothing), each arm's 3 seeds in one process, the two side by side under MPS
 # on one GPU, each cut by its own timeout if it has not finished by then; then each seed's policy exported for the
-# reference evaluation. Into $OUT: her.tgz and splid.tgz (each arm's exports), runs.tgz (metrics, configs, logs).
+# reference evaluation. Into $OUT: ARM-MEMBER.tgz (each seed's export), runs.tgz (metrics, configs, logs).
 export NCCL_NVLS_ENABLE=0 PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false
 python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
 export PYTHONPATH=$PWD:/tmp/site
@@ -29,7 +29,7 @@ arm splid $STOP_SPLID $P &
 wait
 rm -rf $W/arms/*/checkpoints $W/arms/*/*/checkpoints 2>/dev/null
 cd /tmp
-for n in her splid; do [ -d ff/export/$n ] && tar czf $OUT/$n.tgz ff/export/$n; done
+for d in ff/export/*/*; do [ -d "$d" ] && tar czf $OUT/$(basename $(dirname $d))-$(basename $d).tgz $d; done  # a file per seed: 16 MiB each at most
 find ff -type f \( -name '*.json' -o -name '*.jsonl' -o -name '*.log' -o -name '*.txt' \) -not -path 'ff/export/*/*/*' -size -4M | tar czf $OUT/runs.tgz -T -
 echo "top $TOP, $(( $(date +%s) - T0 ))s" >> $W/times.txt
 ls -la $OUT; cat $W/times.txt; for f in $W/arms/*.log $W/export/*.log; do echo "== $f"; tail -n 2 $f; done
