@@ -161,8 +161,6 @@ def mjcf(
     drive: str = "pd",
     finger_table: float = 0.0,
     finger_drive: str = "reference",
-    pad_friction: float = 1.0,
-    pad_top_friction: float | None = None,
 ) -> str:
     """The MJCF text of task ``kind`` (one of ``KINDS``); ``table`` is the table's collision shape
     (``tables_for(kind)``), ``finger`` the closed finger block's (``fingers_for(kind)``).
@@ -183,8 +181,7 @@ def mjcf(
     below the grip site and touch the table with this friction (condim 3), so a gripper driven down at
     the table presses on it and drags, as the reference's does under its mocap weld; 0: no such contact.
 
-    ``finger_drive`` (PickAndPlace's free fingers): one of ``FINGER_DRIVES``, see there. ``pad_friction`` and
-    ``pad_top_friction``: Slide's pads on the puck (``slide_fingers``)."""
+    ``finger_drive`` (PickAndPlace's free fingers): one of ``FINGER_DRIVES``, see there."""
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
     if table not in tables_for(kind):
@@ -261,8 +258,7 @@ def mjcf(
     <pair geom1="finger_r" geom2="object" condim="4" friction="1 1 0.005 0.0001 0.0001"/>"""
     elif slide:
         look = f'{nograv} rgba="0.3 0.3 0.3 1"'
-        fingers, finger_pairs, table_fingers = slide_fingers.mjcf(
-            finger, below, finger_table, look, pad_friction, pad_top_friction)
+        fingers, finger_pairs, table_fingers = slide_fingers.mjcf(finger, below, finger_table, look)
         finger_act = ""
     else:
         shape = {
@@ -287,21 +283,14 @@ def mjcf(
     if has_object:
         size = _fmt(OBJECT_HALF, PUCK_HALF_HEIGHT) if slide else _fmt(*obj_half)
         shape = f'type="{"cylinder" if slide else "box"}" size="{size}"'
-        geoms = f"""
-      <geom name="object" {shape} mass="2" {nograv} rgba="0.9 0.2 0.2 1"/>"""
-        capped = slide and pad_top_friction is not None
-        if capped:
-            geoms = slide_fingers.capped_puck(OBJECT_HALF, PUCK_HALF_HEIGHT, 2.0, f'{nograv} rgba="0.9 0.2 0.2 1"')
         obj = f"""
     <body name="object" pos="{_fmt(ox, oy, rest_z)}">
-      <freejoint name="object"/>{geoms}
+      <freejoint name="object"/>
+      <geom name="object" {shape} mass="2" {nograv} rgba="0.9 0.2 0.2 1"/>
       <site name="object" pos="0 0 0" size="0.005"/>
     </body>"""
         obj_pairs = f"""
     <pair geom1="object" geom2="table" condim="3" friction="{friction}"/>"""
-        if capped:  # a puck on its side or upside down meets the table with its cap too
-            obj_pairs += f"""
-    <pair geom1="object_top" geom2="table" condim="3" friction="{friction}"/>"""
         if not plane_top:  # on an infinite plane top the object cannot fall to the floor
             obj_pairs += """
     <pair geom1="object" geom2="floor" condim="3"/>"""

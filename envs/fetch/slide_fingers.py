@@ -11,18 +11,9 @@
   them into the puck far harder than the PD drive: with ``drive=weld`` and ``gripper_mass=22`` (its arm's effective
   mass along z at the grip site) they sink as deep as there and drag the puck as fast
   (``experiments/reference/results/slide-pads.md``, which also says what still differs).
-
-``pad_top_friction`` (pads only, experimental): the pads' friction on the puck's top face alone. The puck's top
-then is a thin cap of its own (``CAP_HEIGHT``, ``CAP_INSET`` narrower, so a pad flat on the side wall stays
-beyond the pair's margin from it), with its own pad pairs, so a pad pressed on the puck slips at that friction
-while a strike on the side meets the rest of the puck at the side's (``pad_friction``). The puck keeps its
-height, mass and inertia. A stand-in: the reference's pads have one friction everywhere, and its pressed puck
-escapes otherwise (experiments/NOTES.md, "Where Slide's episodes part from the reference").
 """
 
 from __future__ import annotations
-
-from envs.settings import check
 
 FINGERS = ("box", "pads")
 TIP_XY = 0.0155  # "box": fingertip corner centres at (+-, +-) this from the grip site: scripted.FINGER_HALF_XY
@@ -34,40 +25,18 @@ PAD_HALF = (0.0135, 0.007, 0.0385)
 PAD_CENTERS = ((-0.001, 0.008, 0.02), (-0.001, -0.0095, 0.02))
 # the pad-puck pair as MuJoCo mixes a pad (condim 4, friction 1 0.05 0.01, margin 0.001, solref 0.01 1, solimp
 # 0.99 0.99 0.01) with the puck (condim 3, friction 0.1 0.005 0.0001, the default solref and solimp)
-PAD_PUCK_CONTACT = ('condim="4" friction="{mu} {mu} 0.05 0.01 0.01" margin="0.001" solref="0.015 1" '
+PAD_PUCK_CONTACT = ('condim="4" friction="1 1 0.05 0.01 0.01" margin="0.001" solref="0.015 1" '
                     'solimp="0.945 0.97 0.0055 0.5 2"')  # fmt: skip
-# the top cap (pad_top_friction): deeper than a hard press sinks a pad into the puck plus the pair's margin, so a
-# pressed pad meets the cap alone, and inset by more than the margin plus a strike's sinking into the side wall
-CAP_HEIGHT = 0.005
-CAP_INSET = 0.002
-
-
-def check_options(task) -> None:
-    """Raise naming the field unless the pads' frictions (``pad_friction``, ``pad_top_friction``) are in (0, 2] on
-    Slide with ``finger="pads"``, the only task whose pairs take them, and at their defaults elsewhere."""
-    pads = task.kind == "slide" and task.finger == "pads"
-    for name, unset in (("pad_friction", 1), ("pad_top_friction", None)):
-        v = getattr(task, name)
-        ok = v == unset or (pads and isinstance(v, (int, float)) and not isinstance(v, bool) and 0 < v <= 2)
-        check(ok, f"{task.kind}.{name}", v, f"in (0, 2] on Slide with finger=pads, else {unset if unset else 'unset'}")
 
 
 def _fmt(*xs: float) -> str:
     return " ".join(f"{x:.6g}" for x in xs)
 
 
-def mjcf(
-    finger: str,
-    below: float,
-    finger_table: float,
-    visual: str,
-    pad_friction: float = 1.0,
-    pad_top_friction: float | None = None,
-) -> tuple[str, str, tuple[str, ...]]:
+def mjcf(finger: str, below: float, finger_table: float, visual: str) -> tuple[str, str, tuple[str, ...]]:
     """(the gripper body's finger geoms, the finger-puck contact pairs, the names of the geoms that may touch the
     table) for ``finger``; ``below``: how far the fingertips reach below the grip site ("box"), ``finger_table``
-    whether they touch the table, ``visual`` the geoms' shared attributes, ``pad_friction`` the pads' sliding
-    friction on the puck (the reference's is 1), ``pad_top_friction`` on its top cap alone (None: no cap)."""
+    whether they touch the table, ``visual`` the geoms' shared attributes."""
     if finger == "pads":
         (hx, hy, hz), names = PAD_HALF, ("pad_r", "pad_l")
         geoms = "".join(
@@ -75,13 +44,8 @@ def mjcf(
       <geom name="{n}" type="box" size="{_fmt(hx, hy, hz)}" pos="{_fmt(*c)}" mass="0.001" {visual}/>"""
             for n, c in zip(names, PAD_CENTERS, strict=True)
         )
-        contact = PAD_PUCK_CONTACT.format(mu=f"{pad_friction:.6g}")
         pairs = "".join(f"""
-    <pair geom1="{n}" geom2="object" {contact}/>""" for n in names)  # fmt: skip
-        if pad_top_friction is not None:
-            top = PAD_PUCK_CONTACT.format(mu=f"{pad_top_friction:.6g}")
-            pairs += "".join(f"""
-    <pair geom1="{n}" geom2="object_top" {top}/>""" for n in names)  # fmt: skip
+    <pair geom1="{n}" geom2="object" {PAD_PUCK_CONTACT}/>""" for n in names)  # fmt: skip
         return geoms, pairs, names
     # Closed fingers drawn as a block; they strike the puck with four round corner tips. With a finger-table
     # contact the block and the tips reach the reference's fingertips' depth, the tips' bottoms level with
@@ -98,15 +62,3 @@ def mjcf(
     pairs = "".join(f"""
     <pair geom1="{n}" geom2="object" condim="4" friction="{TIP_FRICTION}"/>""" for n, _, _ in tips)  # fmt: skip
     return geoms, pairs, ("fingers",)
-
-
-def capped_puck(radius: float, half_height: float, mass: float, look: str) -> str:
-    """The puck's geoms with a top cap (``pad_top_friction``): the body "object" (a cylinder of ``radius`` and
-    ``half_height``) and the cap "object_top" on it, with the whole cylinder's mass and inertia, so the puck
-    moves as the uncapped one."""
-    r, h, t = radius, half_height, CAP_HEIGHT
-    side = mass * (3 * r * r + 4 * h * h) / 12  # a solid cylinder's, about a horizontal axis through its centre
-    return f"""
-      <inertial pos="0 0 0" mass="{mass:.6g}" diaginertia="{side:.12g} {side:.12g} {mass * r * r / 2:.12g}"/>
-      <geom name="object" type="cylinder" size="{_fmt(r, h - t / 2)}" pos="0 0 {-t / 2:.6g}" {look}/>
-      <geom name="object_top" type="cylinder" size="{_fmt(r - CAP_INSET, t / 2)}" pos="0 0 {h - t / 2:.6g}" {look}/>"""

@@ -36,7 +36,7 @@ import jax
 import jax.numpy as jnp
 
 from envs.base import GoalEnv, State, flag_invalid, make_data, mjx_substeps
-from envs.fetch import control, kernels, models, observation, slide_fingers
+from envs.fetch import control, kernels, models, observation
 from envs.fetch.observation import Physics
 from envs.physics import BACKENDS, KERNELS_CHECKED, in_use, kernels_checked
 from envs.settings import check, check_integer
@@ -108,12 +108,6 @@ class _FetchTask(GoalEnv):
     # The gripper's mass in kg (0: the task's, models.mjcf): how hard the weld drive presses (Slide's pads sink
     # into the puck as deep as the reference's at 22 kg, its arm's effective mass along z at the grip site)
     gripper_mass: float = experimental(0.0, recorded_when_set=True)
-    # The Slide pads' sliding friction on the puck (finger=pads; the reference's 1): how readily a pressed puck
-    # slips out from under them (NOTES, "Where Slide's episodes part from the reference")
-    pad_friction: float = experimental(1.0, recorded_when_set=True)
-    # Their friction on the puck's top face alone (None: pad_friction's), given by a cap of its own: a pressed
-    # puck slips out at this friction while a strike on its side keeps pad_friction (slide_fingers)
-    pad_top_friction: float | None = experimental(None, recorded_when_set=True)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -154,7 +148,6 @@ class _FetchTask(GoalEnv):
         check(0 <= self.floor_clearance <= 0.1, f"{n}.floor_clearance", self.floor_clearance, "in [0, 0.1] m")
         check(0 <= self.finger_table <= 2, f"{n}.finger_table", self.finger_table, "in [0, 2]")
         check(0 <= self.gripper_mass <= 100, f"{n}.gripper_mass", self.gripper_mass, "in [0, 100] kg (0: the task's)")
-        slide_fingers.check_options(self)
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -185,8 +178,6 @@ class _FetchTask(GoalEnv):
             drive=str(self.drive),
             finger_table=float(self.finger_table),
             **({"gripper_mass": float(self.gripper_mass)} if self.gripper_mass else {}),
-            **({"pad_friction": float(self.pad_friction)} if self.pad_friction != 1 else {}),
-            **({"pad_top_friction": float(self.pad_top_friction)} if self.pad_top_friction is not None else {}),
         )
 
     @property

@@ -21,8 +21,6 @@ def loadable(cfg):
     if options.get("finger") != "pads" or kernels_checked():
         return cfg
     options["finger"] = "box"
-    for own in ("pad_friction", "pad_top_friction"):  # the pads' own
-        options.pop(own, None)
     return dataclasses.replace(cfg, env_options=format_overrides(options))
 
 

@@ -12,7 +12,5 @@ def test_pads_load_with_the_box_fingers_inputs_only_off_the_kernels_release(monk
     monkeypatch.setattr(envs.physics, "kernels_checked", lambda: False)
     other = side.loadable(cfg)
     assert other.env_options == "finger=box,finger_table=1,drive=weld" and other.env == "slide"
-    faces = TrainConfig(env="slide", env_options="finger=pads,pad_friction=0.5,pad_top_friction=0.2")
-    assert side.loadable(faces).env_options == "finger=box"  # the pads' own frictions go with them
     plain = TrainConfig(env="slide", env_options="drive=weld")
     assert side.loadable(plain) is plain

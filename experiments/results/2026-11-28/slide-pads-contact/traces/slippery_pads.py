@@ -1,4 +1,4 @@
-"""A run's Slide policy in our task alone with the pad-puck friction changed (before the task option ``pad_friction``:
+"""A run's Slide policy in our task alone with the pad-puck friction changed (no task option holds it: it is
 ``slide_fingers.PAD_PUCK_CONTACT``'s, replaced here before the task is built), from the evaluator's starts: success,
 and how the pads keep the puck (``parting.holding``). Asks whether our pads holding the puck less firmly, as the
 reference's do, loses the final step as the reference does.
@@ -31,7 +31,7 @@ def main(argv=None) -> int:
     if args.friction is not None:
         mu = float(args.friction)
         slide_fingers.PAD_PUCK_CONTACT = slide_fingers.PAD_PUCK_CONTACT.replace(
-            'friction="{mu} {mu} ', f'friction="{mu} {mu} '
+            'friction="1 1 ', f'friction="{mu} {mu} '
         )
         assert f'friction="{mu} {mu} ' in slide_fingers.PAD_PUCK_CONTACT
     import jax
