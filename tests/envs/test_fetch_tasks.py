@@ -185,6 +185,8 @@ def test_arm_reach_barely_touches_push_pick_and_reach_goal_regions():
 def test_unknown_override_fails_naming_it():
     with pytest.raises(InvalidConfig, match=r"push\.friction"):
         envs.make("push", friction=1.0)
+    with pytest.raises(InvalidConfig, match=r"slide\.pad_friction=0\.2: must be unset: the option left the package"):
+        envs.make("slide", finger="pads", pad_friction=0.2)  # a run recorded with it says why it cannot load
 
 
 def test_making_a_fetch_task_prints_nothing():  # MJX's notice on import where its Warp backend is absent
