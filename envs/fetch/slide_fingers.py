@@ -20,9 +20,10 @@ TIP_XY = 0.0155  # "box": fingertip corner centres at (+-, +-) this from the gri
 TIP_RADIUS = 0.004
 TIP_FRICTION = "1 1 0.05 0.01 0.01"  # the reference finger-puck pair: friction 1, torsional 0.05, condim 4
 # "pads": a reference finger geom's half sizes (x, y, z in the world at the Slide start; its long axis is
-# vertical) and the centres of the right and left ones about the grip site, read off FetchSlide-v4's model at reset
+# vertical) and the centres of the right and left ones about the grip site, read off FetchSlide-v4 where its pads are
+# when they strike (at reset its left finger is still open, 1.5 mm further out: NOTES, "The strike, traced")
 PAD_HALF = (0.0135, 0.007, 0.0385)
-PAD_CENTERS = ((-0.001, 0.008, 0.02), (-0.001, -0.0095, 0.02))
+PAD_CENTERS = ((-0.0002, 0.008, 0.02), (-0.0002, -0.008, 0.02))
 # the pad-puck pair as MuJoCo mixes a pad (condim 4, friction 1 0.05 0.01, margin 0.001, solref 0.01 1, solimp
 # 0.99 0.99 0.01) with the puck (condim 3, friction 0.1 0.005 0.0001, the default solref and solimp)
 PAD_PUCK_CONTACT = ('condim="4" friction="1 1 0.05 0.01 0.01" margin="0.001" solref="0.015 1" '
