@@ -155,12 +155,12 @@ def main(argv: list[str] | None = None) -> int:
             else:
                 result = evaluate(a.run_dir, a.episodes, a.seed, env_options=a.env_options, loaded=loaded,
                                   reference_python=a.reference_python)  # fmt: skip
+                if a.traces:
+                    cfg, env, policy, pstate, _ = loaded
+                    pol = lambda o, g: policy.act(pstate, o, g)  # noqa: E731
+                    tr = traces(env, cfg.env, pol, policy_act(policy, pstate), a.episodes, a.seed)
             what = f"{result['algo']} on {result['task']}, iteration {result['step']}"
             title = f"{a.run_dir} ({what}), {a.episodes} episodes each"
-            if a.traces and not a.reference_python:
-                cfg, env, policy, pstate, _ = loaded
-                pol = lambda o, g: policy.act(pstate, o, g)  # noqa: E731
-                tr = traces(env, cfg.env, pol, policy_act(policy, pstate), a.episodes, a.seed)
     except (EvaluationError, InvalidConfig, CheckpointError) as err:
         print(f"{p.prog}: error: {flag_error(err, p)}", file=sys.stderr)
         return 2
