@@ -23,9 +23,9 @@ from tests.helpers import random_policy_success, with_counted_jit
 CFG = dict(env="point", num_envs=16, iterations=150, eval_every=25, eval_episodes=256)
 HER_CFG = dict(BASELINES, hidden=(64, 64, 64), buffer_transitions=100_000, batch_size=256)
 CHUNKS = 6  # 150 cycles, 2,400 episodes
-# The suite compiles at LLVM's level 0 (conftest.CPU_COMPILE_FLAGS), right for programs run once or twice;
-# this chunk runs 9 times here, 2.5x faster at level 2 for 3 s more compiling (about 20 s less in all), and the
-# mrl preset's chunk (25 cycles of 50 updates) runs twice. Every run the tests compare comes from one compiled chunk.
+# The suite compiles at LLVM's level 0 (conftest.CPU_COMPILE_FLAGS), right for programs run once or twice (the
+# mrl preset's chunk below); this chunk runs 9 times here, 2.5x faster at level 2 for 3 s more compiling (about 20 s
+# less in all). Every run the tests compare comes from one compiled chunk.
 RUN_FAST = {"xla_backend_optimization_level": 2}
 
 
@@ -313,18 +313,18 @@ def test_blocks_of_target_every_steps_equal_the_steps_one_at_a_time():
 
 
 def test_the_mrl_preset_learns_the_point_task_within_400_episodes():
-    """mrl's settings scaled to the CPU (narrower nets, smaller batches, a step per 8 transitions, warm-ups
+    """mrl's settings scaled to the CPU (narrower nets, batches of 64, a step per 8 transitions, warm-ups
     shortened in proportion). Without its gradient steps the policy would stay at its initial one, which rarely
     reaches the goal."""
-    small = dict(hidden=(64, 64), batch_size=256, buffer_transitions=100_000, update_every=8)
+    small = dict(hidden=(64, 64), batch_size=64, buffer_transitions=100_000, update_every=8)
     small.update(random_transitions=2_000, warm_up=1_000, actual_warm_up=5_000)
     cfg = TrainConfig(**{**CFG, "num_envs": 8, "iterations": 50, "eval_every": 25})
     her = HER(envs.make("point"), cfg, HerConfig(**small))
     assert her.n_updates == 50
-    state, chunk = her.init(jax.random.PRNGKey(0)), jax.jit(her.chunk, compiler_options=RUN_FAST)
+    state, chunk = her.init(jax.random.PRNGKey(0)), jax.jit(her.chunk)  # run twice: the suite's level 0
     for _ in range(2):
         state, metrics = chunk(state, her.hyper())
     baseline = random_policy_success(her.env)
-    # seed 0 reaches 0.70 against a random policy's 0.20
+    # seeds 0 and 1 reach 0.68 and 0.61 against a random policy's 0.20
     assert float(metrics["eval_success_final"]) > baseline + 0.3, (metrics, baseline)
     assert float(metrics["critic_loss"]) > 0 and int(metrics["buffer_size"]) == 400
