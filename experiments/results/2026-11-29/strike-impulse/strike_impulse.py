@@ -150,6 +150,9 @@ def patch_pair(
         models.mjcf = mjcf
 
 
+SLIDE = {}  # keyword arguments of the scripted strike (``--aim-short``)
+
+
 def run_ours(options: dict, episodes: int, seed: int) -> tuple[dict, dict]:
     import dataclasses
 
@@ -185,7 +188,7 @@ def run_ours(options: dict, episodes: int, seed: int) -> tuple[dict, dict]:
 
     def one_episode(s0):
         def control_step(s, _):
-            act = sc.slide(s.obs, s.desired_goal)
+            act = sc.slide(s.obs, s.desired_goal, **SLIDE)
             ctrl = env._control(s.physics, env._action(act))
 
             def sub(phys, _):
@@ -268,7 +271,7 @@ def run_reference(starts: dict) -> dict:
         start, goal = obs["achieved_goal"][:2].copy(), obs["desired_goal"][:2].copy()
         any_ok = False
         for _ in range(env.spec.max_episode_steps):
-            act = np.asarray(sc.slide(obs["observation"], obs["desired_goal"]), np.float64)
+            act = np.asarray(sc.slide(obs["observation"], obs["desired_goal"], **SLIDE), np.float64)
             obs, _, _, _, info = env.step(act)
             any_ok |= bool(info["is_success"])
         uv = np.asarray(sc.launch_velocity(np.asarray(goal - start, np.float32)[None], DECEL))[0]
@@ -373,12 +376,14 @@ def main(argv=None) -> int:
     p.add_argument("--pads-symmetric", action="store_true", help="the pads' centres mirrored about the grip site")
     p.add_argument("--pad-xy", default=None, help="x,y: the pads' centres at (x, +-y) about the grip site")
     p.add_argument("--weld-solref", default=None, help='the weld drive\'s solref (models.WELD_SOLREF), e.g. "0.01 1"')
+    p.add_argument("--aim-short", type=float, default=0.0, help="the strike aimed to stop this fraction short (slower)")
     p.add_argument("--label", default=None)
     p.add_argument("--out")
     a = p.parse_args(argv)
     if a.side in ("summarise", "trim"):
         (summarise if a.side == "summarise" else trim)(a.files)
         return 0
+    SLIDE.update(aim_short=a.aim_short) if a.aim_short else None
     if a.side == "ours":
         from splid_jax.common.values import parse_overrides
 

@@ -41,3 +41,7 @@ $REF/bin/python $D/strike_impulse.py reference --starts $D/raw/starts200_seed1.n
 $PY $D/strike_impulse.py trim $D/raw/sweep_*.json.gz $D/raw/ours_seed1.json.gz $D/raw/pads_at_strike_seed1.json.gz
 $PY $D/strike_impulse.py summarise $D/raw/reference.json.gz $D/raw/reference_mujoco317.json.gz $D/raw/ours.json.gz \
     $D/raw/sweep_*.json.gz $D/raw/reference_seed1.json.gz $D/raw/ours_seed1.json.gz $D/raw/pads_at_strike_seed1.json.gz
+# the strike aimed 0.75 short (launched at half the speed), 50 starts of seed 0
+$PY $D/strike_impulse.py ours --episodes 50 --aim-short 0.75 --starts $D/raw/starts50.npz --label "ours, aimed 0.75 short" --out $D/raw/slow_ours.json.gz
+$REF/bin/python $D/strike_impulse.py reference --aim-short 0.75 --starts $D/raw/starts50.npz --label "FetchSlide-v4 3.11.0, aimed 0.75 short" --out $D/raw/slow_reference.json.gz
+$PY $D/strike_impulse.py trim $D/raw/slow_ours.json.gz $D/raw/slow_reference.json.gz
