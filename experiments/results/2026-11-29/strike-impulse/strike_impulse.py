@@ -14,7 +14,8 @@ how far it slides after the last touch.
 model is built; ``--puck-friction`` the puck's sliding friction on the table (``models``' Slide friction string);
 ``--weld-solref`` the weld drive's (``models.WELD_SOLREF``); ``--armature`` adds inertia along the gripper's slide
 joints (x, y, z); ``--pads-symmetric`` centres the two pads about the grip site, ``--pad-xy X,Y`` puts them at
-(X, +-Y). Ours needs ``finger=pads``.
+(X, +-Y). Ours needs ``finger=pads``. ``--aim-short F`` (both sides) aims the strike to stop F of the way short,
+launching it slower.
 
 A touch: a pad within the pair's margin (1 mm) of the puck (ours: ``envs/box_cylinder.py`` on the step's poses;
 the reference: a finger-puck contact in MuJoCo's list). Per episode: the grip's speed along the launch line at the
