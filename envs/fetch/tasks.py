@@ -350,8 +350,16 @@ class Push(_FetchTask):
 @dataclasses.dataclass(frozen=True)
 class Slide(_FetchTask):
     """Strike a low-friction puck (a cylinder on a plane table top, see models.py) to a goal 0.4 m ahead,
-    out of reach."""
+    out of reach. The fingers are the reference's: box pads (``finger="pads"``, a box-cylinder contact MJX
+    lacks, envs/fetch/slide_fingers.py) that touch the table, moved by the reference's weld law with its
+    arm's effective mass: round fingertips let a policy ride the puck on its top face, a strategy the
+    reference does not allow, so their policies failed there (experiments/NOTES.md, "Slide with the
+    reference's pads")."""
 
+    finger: str = "pads"
+    finger_table: float = 1.0
+    drive: str = "weld"
+    gripper_mass: float = 22.0
     obj_range: float = 0.1
     target_range: float = 0.3
     iterations: int = 10  # 4 let a resting low-friction puck creep in float32 (up to 10 cm in 50 steps)

@@ -12,13 +12,15 @@ import sys
 
 
 def loadable(cfg):
-    """``cfg`` with a task this MuJoCo builds: the pads' contact is checked on the kernels' release alone, and a
-    policy of theirs takes the box fingers' inputs (nothing of our task is stepped here)."""
+    """``cfg`` with a task this MuJoCo builds: Slide's pads' contact (its default) is checked on the kernels' release
+    alone, and a policy of theirs takes the box fingers' inputs (nothing of our task is stepped here)."""
+    import envs
     from envs.physics import kernels_checked
     from splid_jax.common.values import format_overrides, parse_overrides
 
     options = parse_overrides(cfg.env_options)
-    if options.get("finger") != "pads" or kernels_checked():
+    task_default = {f.name: f.default for f in dataclasses.fields(envs.task_class(cfg.env))}.get("finger")
+    if cfg.env != "slide" or options.get("finger", task_default) != "pads" or kernels_checked():
         return cfg
     options["finger"] = "box"
     return dataclasses.replace(cfg, env_options=format_overrides(options))

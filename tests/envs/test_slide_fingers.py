@@ -45,16 +45,18 @@ def test_the_box_cylinder_entry_lives_only_while_mjx_uses_it():
         mjx.put_model(models.build("slide", finger="pads", finger_table=1.0)[0])
 
 
-def test_round_tips_stay_the_default():
-    assert envs.make("slide").finger == "box"
-    m = models.build("slide")[0]
-    names = {m.geom(i).name for i in range(m.ngeom)}
-    assert {"tip_0", "tip_3"} <= names and not {"pad_r", "pad_l"} & names
+def test_the_reference_pads_are_slides_default():
+    task = envs.make("slide")
+    assert (task.finger, task.finger_table, task.drive, task.gripper_mass) == ("pads", 1.0, "weld", 22.0)
+    names = {task.mj_model.geom(i).name for i in range(task.mj_model.ngeom)}
+    assert {"pad_r", "pad_l"} <= names and not {"tip_0", "tip_3"} & names
+    m = envs.make("slide", finger="box", finger_table=0.0, drive="pd", gripper_mass=0.0).mj_model  # the former task
+    assert {"tip_0", "tip_3"} <= {m.geom(i).name for i in range(m.ngeom)}
 
 
 def test_gripper_mass_is_recorded_only_when_set():
-    assert "gripper_mass" not in envs.make("slide").settings()  # runs recorded before it still resume
-    assert envs.make("slide", gripper_mass=22.0).settings()["gripper_mass"] == 22.0
+    assert "gripper_mass" not in envs.make("push").settings()  # runs recorded before it still resume
+    assert envs.make("slide").settings()["gripper_mass"] == 22.0
     assert models.build("slide", gripper_mass=22.0)[0].body("gripper").mass[0] == pytest.approx(22.0, abs=0.01)
 
 

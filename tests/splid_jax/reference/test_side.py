@@ -12,5 +12,7 @@ def test_pads_load_with_the_box_fingers_inputs_only_off_the_kernels_release(monk
     monkeypatch.setattr(envs.physics, "kernels_checked", lambda: False)
     other = side.loadable(cfg)
     assert other.env_options == "finger=box,finger_table=1,drive=weld" and other.env == "slide"
-    plain = TrainConfig(env="slide", env_options="drive=weld")
+    default = side.loadable(TrainConfig(env="slide"))  # Slide's default fingers are the pads
+    assert default.env_options == "finger=box"
+    plain = TrainConfig(env="push", env_options="drive=weld")
     assert side.loadable(plain) is plain
