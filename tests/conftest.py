@@ -77,24 +77,24 @@ def pytest_unconfigure(config):
 
 
 # Test files that step or lower the same programs (``FetchEpisodes``'s Push programs below, and
-# helpers.solver_program's and helpers.lowered_step's): one xdist work unit each, so they run on one
-# worker and each program compiles, or each step is traced, once.
+# helpers.solver_program's and helpers.lowered_step's): one xdist work unit, so they run on one worker and each
+# program compiles, or each step is traced, once (test_fused_collision steps the library-Cholesky Push program of
+# test_small_cholesky and lowers the Push step of test_kernel_batch).
 SHARED_PROGRAMS = {
-    "tests/envs/test_fetch_tasks.py": "fetch-episodes",
-    "tests/envs/test_small_cholesky.py": "fetch-episodes",
-    "tests/splid_jax/learners/splid/test_select_mjx.py": "fetch-episodes",
-    "tests/envs/test_solver_loops.py": "push-kernels",
-    "tests/envs/test_fused_solver.py": "push-kernels",
-    "tests/envs/test_fused_collision.py": "push-kernels",
-    "tests/envs/test_kernel_batch.py": "push-kernels",
+    "tests/envs/test_fetch_tasks.py": "push-programs",
+    "tests/envs/test_small_cholesky.py": "push-programs",
+    "tests/splid_jax/learners/splid/test_select_mjx.py": "push-programs",
+    "tests/envs/test_solver_loops.py": "push-programs",
+    "tests/envs/test_fused_solver.py": "push-programs",
+    "tests/envs/test_fused_collision.py": "push-programs",
+    "tests/envs/test_kernel_batch.py": "push-programs",
 }
 # The longest units' seconds on a 2-core CPU shared with other work (a full run's --durations, summed per
 # unit; one that ran beside a busy neighbour reads long). They go out first, longest first, so the last
 # units handed out are short and the two workers end together (in the order of collection, a worker once
 # sat idle for the last 90 s). Only the order depends on these.
 UNIT_SECONDS = {
-    "push-kernels": 80,
-    "fetch-episodes": 74,
+    "push-programs": 148,
     "tests/splid_jax/runtime/test_multihost.py": 43,
     "tests/splid_jax/learners/her/test_her.py": 41,
     "tests/splid_jax/test_train_processes.py": 33,

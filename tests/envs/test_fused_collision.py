@@ -15,7 +15,6 @@ from mujoco.mjx._src.collision_types import GeomInfo
 import envs
 from envs import box_contacts, fused_collision
 from envs.fetch.kernels import runs_as_kernel
-from envs.fetch.scripted import CONTROLLERS
 from tests.helpers import needs_kernels, triton_calls_in_step
 
 
@@ -88,23 +87,19 @@ def test_kernels_are_the_functions_and_lower_as_one_triton_call_each():
 
 
 @functools.cache
-def _scripted_run(**options):
-    """The task and its physics after each of 8 steps of 8 Push envs under the scripted pusher, with the MJX
-    solver's loops: one compiled program per choice of ``options``, read by the tests below. The library's
-    Cholesky (the same physics to float rounding, both paths alike) keeps the programs' compiles short."""
-    env = envs.make("push", solver_loops="loops", cholesky="library", **options)
-    state = jax.jit(jax.vmap(env.reset))(jax.random.split(jax.random.PRNGKey(0), 8))
-    act = jax.vmap(CONTROLLERS["push"])
-
-    def step(s, _):
-        s = jax.vmap(env.step)(s, act(s.obs, s.desired_goal))
-        return s, s.physics
-
-    return env, jax.jit(lambda s: jax.lax.scan(step, s, None, length=8)[1])(state)
+def _scripted_run(fetch, **options):
+    """The task and its physics after each of the first 8 steps of 8 Push envs under the scripted pusher, from
+    FetchEpisodes' program (no action added to the script's): one compiled program per choice of ``options``, read
+    by the tests below. The library's Cholesky (the same physics to float rounding, both paths alike) keeps the
+    programs' compiles short, and the task without options is test_small_cholesky's (conftest puts the files on
+    one worker)."""
+    env = envs.make("push", cholesky="library", **options)
+    _, _, path = fetch.run(env, jnp.zeros((fetch.T, fetch.B, env.action_size)), w=1.0)
+    return env, jax.tree_util.tree_map(lambda x: x[:8], path.physics)
 
 
-def test_push_states_get_mjxs_contacts():
-    env, physics = _scripted_run()
+def test_push_states_get_mjxs_contacts(fetch):
+    env, physics = _scripted_run(fetch)
     contacts = functools.partial(fused_collision.contacts, env)
     mjxs, ours = (jax.jit(jax.vmap(functools.partial(contacts, fused=f))) for f in (False, True))
     touching = 0
@@ -118,10 +113,10 @@ def test_push_states_get_mjxs_contacts():
     assert touching > 50
 
 
-def test_push_path_follows_mjxs():
+def test_push_path_follows_mjxs(fetch):
     # the finger block meets the cube from the seventh step on: without its contacts the path parts there by 0.017;
     # from the eighth, contact amplifies float rounding (to 2e-4 in a cube's orientation with the library's Cholesky)
-    base, fused = (np.asarray(_scripted_run(**options)[1].qpos) for options in ({}, {"collision": "fused"}))
+    base, fused = (np.asarray(_scripted_run(fetch, **options)[1].qpos) for options in ({}, {"collision": "fused"}))
     assert np.isfinite(fused).all()
     np.testing.assert_allclose(fused[:7], base[:7], atol=1e-5)
     np.testing.assert_allclose(fused[7:], base[7:], atol=1e-3)
