@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import jax
 import jax.numpy as jnp
+import mujoco
 import numpy as np
 import pytest
 from mujoco import mjx
@@ -37,7 +38,11 @@ def test_kernels_take_batches_up_to_the_limit_and_xla_larger_ones():
 def test_a_batch_above_the_limit_is_mjxs_own_solve():
     env = envs.make("push")
     model = env.mjx_model
-    data = jax.jit(mjx.forward)(model, mjx.make_data(model).replace(qpos=jnp.asarray(env.mj_model.qpos0)))
+    # Push at rest from MuJoCo's own forward step, its constraints in MJX's layout (MJX's forward compiles seconds)
+    at_rest = mujoco.MjData(env.mj_model)
+    mujoco.mj_forward(env.mj_model, at_rest)
+    data = mjx.put_data(env.mj_model, at_rest)
+    assert fused_solver.covers(model, data)  # a solve the fused one takes, below the limit
     warm = data.qacc + 0.1 * jax.random.normal(jax.random.PRNGKey(4), (5, model.nv))
 
     def solved(solve):  # only the warm start batched: the other fields reach the solve unbatched
