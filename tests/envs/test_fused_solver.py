@@ -21,23 +21,28 @@ def test_fused_solve_follows_mjx_path():
     np.testing.assert_allclose(fused, loops, atol=1e-5)
 
 
-@functools.partial(jax.jit, static_argnames=("nefc", "nv"))  # one program, not an operation at a time
-def _problem(key, nefc=40, nv=9):
-    """A random solve with a third of the rows pushing against their constraint (negative aref)."""
-    k = jax.random.split(key, 6)
-    j = jax.random.normal(k[0], (nefc, nv))
-    a = jax.random.normal(k[1], (nv, nv))
-    m = a @ a.T + nv * jnp.eye(nv)
-    d = jax.random.uniform(k[2], (nefc,), minval=0.1, maxval=10.0)
-    aref = jax.random.normal(k[3], (nefc,)) - 0.3
-    qfrc_smooth, qacc_smooth = jax.random.normal(k[4], (2, nv))
-    qacc_warm = qacc_smooth + 0.1 * jax.random.normal(k[5], (nv,))
-    return j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, jnp.trace(m)
+def _problem(seed, nefc=40, nv=9):
+    """A random solve with a third of the rows pushing against their constraint (negative aref), drawn by
+    numpy (no program compiled for it)."""
+    rng = np.random.default_rng(seed)
+    j = rng.normal(size=(nefc, nv))
+    a = rng.normal(size=(nv, nv))
+    m = a @ a.T + nv * np.eye(nv)
+    d = rng.uniform(0.1, 10.0, nefc)
+    aref = rng.normal(size=nefc) - 0.3
+    qfrc_smooth, qacc_smooth = rng.normal(size=(2, nv))
+    qacc_warm = qacc_smooth + 0.1 * rng.normal(size=nv)
+    return tuple(np.float32(x) for x in (j, d, aref, m, qfrc_smooth, qacc_smooth, qacc_warm, np.trace(m)))
+
+
+def _problems(n, nefc=40):
+    """``n`` of ``_problem``'s, stacked as a batch of envs."""
+    return tuple(np.stack(x) for x in zip(*(_problem(seed, nefc) for seed in range(n)), strict=True))
 
 
 def test_kernel_is_the_function_for_a_batch_of_envs():
     opts = dict(iterations=4, ls_iterations=4, tolerance=1e-8, ls_tolerance=0.01)
-    problems = jax.vmap(_problem)(jax.random.split(jax.random.PRNGKey(0), 3))
+    problems = _problems(3)
     plain = jax.jit(jax.vmap(functools.partial(fused_solver.newton, **opts)))(*problems)
     kernel = jax.jit(jax.vmap(functools.partial(fused_solver.kernel_solve, interpret=True, **opts)))(*problems)
     assert float(jnp.abs(plain[2]).max()) > 0  # some rows push
@@ -46,7 +51,7 @@ def test_kernel_is_the_function_for_a_batch_of_envs():
 
 
 def test_masked_cholesky_solves_the_system():
-    j, _, _, m, b, *_ = _problem(jax.random.PRNGKey(2))
+    j, _, _, m, b, *_ = _problem(2)
     np.testing.assert_allclose(fused_solver.chol_solve(m, b), jnp.linalg.solve(m, b), rtol=1e-5, atol=1e-6)
 
 
@@ -67,7 +72,7 @@ def test_kernel_lowers_through_triton_as_one_call_for_a_batch():
     # lowered for a GPU on this host (Pallas's Triton lowering needs no device): a construct Triton cannot
     # hold fails here, not first on a GPU machine
     opts = dict(iterations=4, ls_iterations=4, tolerance=1e-8, ls_tolerance=0.01)
-    problems = jax.vmap(functools.partial(_problem, nefc=56))(jax.random.split(jax.random.PRNGKey(0), 8))
+    problems = _problems(8, nefc=56)
     solve = jax.vmap(functools.partial(fused_solver.kernel_solve, **opts))
     text = jax.jit(solve).trace(*problems).lower(lowering_platforms=("cuda",)).as_text()
     assert text.count("xla.gpu.triton") == 1 and "grid_x = 8" in text
@@ -90,7 +95,7 @@ def test_solve_has_no_while_loop():
     # XLA's Triton compiler on a GPU crashed (segmentation fault) on kernels holding a while loop; the
     # Newton trips and line searches are fixed-count loops with their conditions as masks
     opts = dict(iterations=4, ls_iterations=4, tolerance=1e-8, ls_tolerance=0.01)
-    jaxpr = jax.make_jaxpr(functools.partial(fused_solver.newton, **opts))(*_problem(jax.random.PRNGKey(3)))
+    jaxpr = jax.make_jaxpr(functools.partial(fused_solver.newton, **opts))(*_problem(3))
     names = _primitives(jaxpr.jaxpr)
     assert "scan" in names and "while" not in names
 
