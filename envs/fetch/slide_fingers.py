@@ -1,12 +1,13 @@
 """Slide's closed fingers as MJCF: what strikes and presses the puck (``models.mjcf`` for ``kind="slide"``).
 
-- ``"box"``: a block drawn for the closed fingers that meets the puck through four 4 mm spheres at its corners,
-  since stock MJX collides a cylinder with a sphere but not with a box. A gripper pressed on the puck rests on
-  the spheres, and learnt policies ride the puck's top face where the reference's slip off
+- ``"box"`` (the former default): a block drawn for the closed fingers that meets the puck through four 4 mm
+  spheres at its corners, since stock MJX collides a cylinder with a sphere but not with a box. A gripper pressed
+  on the puck rests on the spheres, and learnt policies ride the puck's top face where the reference's slip off
   (experiments/NOTES.md, "Why learnt Slide policies fail in FetchSlide-v4").
-- ``"pads"``: the reference's two finger pads, boxes of its size at its closed fingers' place about the grip site,
-  with its finger-puck contact (condim 4, friction, margin, solref and solimp as MuJoCo mixes the two geoms'). MJX
-  collides them with the puck through ``envs/box_cylinder.py``, which a step must register (``box_cylinder.groups``).
+- ``"pads"`` (Slide's default): the reference's two finger pads, boxes of its size at its closed fingers' place
+  about the grip site, with its finger-puck contact (condim 4, friction, margin, solref and solimp as MuJoCo mixes
+  the two geoms'). MJX collides them with the puck through ``envs/box_cylinder.py``, which a step must register
+  (``box_cylinder.groups``).
   The reference's fingers also touch its table (``finger_table=1``), and its arm, pulled by a mocap weld, presses
   them into the puck far harder than the PD drive: with ``drive=weld`` and ``gripper_mass=22`` (its arm's effective
   mass along z at the grip site) they sink as deep as there and drag the puck as fast

@@ -72,8 +72,8 @@ class _FetchTask(GoalEnv):
     # Parity-study options (experimental): the reference's variants of parts of the physics.
     # the table's collision shape: its top face as a plane, or the reference's box
     table: str = experimental("plane")
-    # the closed finger block's collision shape (Push: pads, box or capsule, see models.py; Slide: the round tips
-    # (box) or the reference's two box pads (pads), see envs/fetch/slide_fingers.py)
+    # the closed finger block's collision shape (Push: pads, box or capsule, see models.py; Slide: the reference's
+    # two box pads (pads, its default) or round tips (box), see envs/fetch/slide_fingers.py)
     finger: str = experimental("box")
     # how MJX factors its small dense systems: envs/small_cholesky.py or "library"
     cholesky: str = experimental("unrolled")
