@@ -4,7 +4,8 @@ starts (seed 0): success. Run under the reference's interpreter (MuJoCo 3.11.0, 
     PYTHONPATH=. REF/bin/python experiments/results/2026-11-29/pads-centred/reference_knobs.py RUN_DIR KNOB
 
 KNOB: none, arm_damping0 (the arm's seven joints undamped), fingers_stiff (finger joint damping 1e6), weld_stiff /
-weld_0.01 / weld_soft (the mocap weld's solref time constant 0.005 / 0.01 / 0.04 instead of 0.02).
+weld_0.01 / weld_soft (the mocap weld's solref time constant 0.005 / 0.01 / 0.04 instead of 0.02), table_stiff (the
+table's contacts at solref 0.004 1, solimp 0.99 0.99 0.001, its side of every mix: a pressed puck cannot sink).
 """
 import json
 import sys
@@ -33,6 +34,9 @@ def patched(task):
             m.dof_damping[m.jnt_dofadr[m.joint(f"robot0:{side}_gripper_finger_joint").id]] = 1e6
     elif knob == "weld_0.01":
         m.eq_solref[0] = [0.01, 1.0]
+    elif knob == "table_stiff":
+        t = m.geom("table0").id
+        m.geom_solref[t], m.geom_solimp[t, :3], m.geom_solmix[t] = [0.004, 1.0], [0.99, 0.99, 0.001], 1e6
     elif knob != "none":
         raise SystemExit(f"unknown knob {knob}")
     return env
