@@ -32,6 +32,16 @@ class State:
     invalid: jax.Array  # [] bool, a NaN was seen: the episode is flagged, never silently used
 
 
+def _left_out_at(field: dataclasses.Field):
+    """The value at which ``GoalEnv.settings`` leaves ``field`` out; a sentinel no value equals where it never is."""
+    if field.metadata.get("recorded_when_set"):
+        return field.metadata.get("unrecorded", field.default)
+    return field.default if field.metadata.get("numerics_only") else _ALWAYS
+
+
+_ALWAYS = object()
+
+
 @dataclasses.dataclass(frozen=True)
 class GoalEnv(abc.ABC):
     """Base for tasks. Subclasses are frozen dataclasses whose fields are the task's options."""
@@ -52,13 +62,9 @@ class GoalEnv(abc.ABC):
         """Every option of this task, defaults included, by name: what a checkpoint records so that a
         resume under changed task defaults is caught, not silently continued. An option that changes
         only how the same arithmetic is computed (field metadata ``numerics_only``), or one added after
-        runs were recorded whose default is how they ran (``recorded_when_set``), is left out at its
-        default, so runs recorded before it existed still match."""
-        later = ("numerics_only", "recorded_when_set")
-        fields = [
-            f for f in dataclasses.fields(self)
-            if not (any(f.metadata.get(k) for k in later) and getattr(self, f.name) == f.default)
-        ]  # fmt: skip
+        runs were recorded (``recorded_when_set``), is left out at its default, or at the value those runs
+        had (``unrecorded``), so runs recorded before it existed still match."""
+        fields = [f for f in dataclasses.fields(self) if getattr(self, f.name) != _left_out_at(f)]
         return {"task": type(self).__name__, **{f.name: getattr(self, f.name) for f in fields}}
 
     @property

@@ -359,7 +359,7 @@ class Slide(_FetchTask):
     finger: str = "pads"
     finger_table: float = 1.0
     drive: str = "weld"
-    gripper_mass: float = 22.0
+    gripper_mass: float = dataclasses.field(default=22.0, metadata={"recorded_when_set": True, "unrecorded": 0.0})
     obj_range: float = 0.1
     target_range: float = 0.3
     iterations: int = 10  # 4 let a resting low-friction puck creep in float32 (up to 10 cm in 50 steps)

@@ -306,14 +306,19 @@ def _check_meta(meta: dict, expect_meta: dict | None, where: str) -> None:
 def check_meta(run_dir: str | Path, step: int, expect_meta: dict) -> None:
     """A resume's settings against its checkpoint's, before anything is compiled: an edited config.json
     is refused in a moment, not after the compile. A meta that cannot be read is left to ``restore``."""
-    directory = checkpoint_dir(run_dir)
+    meta = saved_meta(run_dir, step)
+    if meta is not None:
+        _check_meta(meta, expect_meta, f"checkpoint {checkpoint_dir(run_dir) / str(step)}")
+
+
+def saved_meta(run_dir: str | Path, step: int) -> dict | None:
+    """The settings a checkpoint was saved with; None where they cannot be read (``restore`` says why)."""
     try:
-        with _manager(directory, read_only=True) as mngr:
+        with _manager(checkpoint_dir(run_dir), read_only=True) as mngr:
             meta = _read_meta(mngr, step)
     except Exception:
-        return
-    if isinstance(meta, dict):
-        _check_meta(meta, expect_meta, f"checkpoint {directory / str(step)}")
+        return None
+    return meta if isinstance(meta, dict) else None
 
 
 def _restore(run_dir, like_state, expect_meta, step) -> tuple[int, Any, dict[str, Any]]:

@@ -3,6 +3,7 @@ the checks that keep one run from overwriting another."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import sys
@@ -10,12 +11,14 @@ import sys
 import envs
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.common.paths import unwritable
+from splid_jax.common.values import format_overrides, parse_overrides
 from splid_jax.config import TrainConfig
 from splid_jax.learners.base import EVAL_KEYS
 from splid_jax.runtime import checkpoint, progress
 
-# Fields a resumed run must share with its checkpoint; the rest may change on resume.
-MAY_CHANGE_ON_RESUME = frozenset({"iterations", "run_dir", "checkpoint_every", "num_devices"})
+# Fields a resumed run must share with its checkpoint; the rest may change on resume. The task's options may be
+# spelt anew: its checkpoint's task settings are what must match (``recorded_task``).
+MAY_CHANGE_ON_RESUME = frozenset({"iterations", "run_dir", "checkpoint_every", "num_devices", "env_options"})
 METRICS = "metrics.jsonl"
 SWEEP = "sweep.json"  # a sweep's config and its members' configs, from which it resumes
 EXPORT = "export.json"  # an exported policy's source run and checkpoint (``splid_jax.export``); not resumed
@@ -139,8 +142,27 @@ def check_run_dir(cfg: TrainConfig, resume: bool, meta: dict | None = None) -> i
     if step is not None and step > cfg.iterations:
         raise InvalidConfig("iterations", cfg.iterations, f">= {step}, the iterations {cfg.run_dir} has completed")
     if step is not None and meta is not None:
+        recorded_task(cfg, checkpoint.saved_meta(cfg.run_dir, step), meta.get("env"))
         checkpoint.check_meta(cfg.run_dir, step, meta)
     return step
+
+
+def recorded_task(cfg: TrainConfig, saved: dict | None, now: dict | None) -> None:
+    """Refuses a resume whose task differs from the one its checkpoint recorded (the task's defaults changed
+    since, say), naming the ``--env-options`` that rebuild the recorded one."""
+    was = (saved or {}).get("env")
+    if not isinstance(was, dict) or not isinstance(now, dict) or was.get("task") != now.get("task"):
+        return
+    fields = {f.name: f for f in dataclasses.fields(envs.task_class(cfg.env))}
+    unset = object()
+    changed = [k for k in now if k in fields and was.get(k, unset) != now[k]]
+    if not changed:
+        return
+    spelt = parse_overrides(cfg.env_options)
+    for k in changed:
+        spelt[k] = was[k] if k in was else fields[k].metadata.get("unrecorded", fields[k].default)
+    why = f"the task {cfg.run_dir} was trained on, whose options differ ({', '.join(changed)})"
+    raise InvalidConfig("env_options", cfg.env_options, f"{why}: --env-options {format_overrides(spelt)}")
 
 
 def check_restartable(cfg: TrainConfig) -> None:

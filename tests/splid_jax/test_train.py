@@ -192,17 +192,20 @@ def test_env_options_build_the_task_the_run_trains_on(tmp_path):
     assert rec["env_steps"] == 5 * 4 * 20  # episodes of the overridden length
 
 
-def test_resume_under_changed_task_defaults_fails_naming_the_option(tmp_path):
-    # the same config both times; only the task itself differs, as after a change of its defaults
-    import envs
-    from splid_jax.runtime.checkpoint import CheckpointError
-
-    cfg = TrainConfig(**TINY_CONFIG, iterations=5, run_dir=str(tmp_path / "run"))
-    run(cfg, env=envs.make("point"), quiet=True)
-    longer = TrainConfig(**{**cfg.__dict__, "iterations": 10})
-    with pytest.raises(CheckpointError, match=r"env\.door_half_width=0\.75 but env\.door_half_width=0\.5"):
-        run(longer, env=envs.make("point", door_half_width=0.5), resume=True, quiet=True)
-    assert run(longer, env=envs.make("point"), resume=True, quiet=True)["iteration"] == 10
+def test_resume_under_changed_task_defaults_names_the_options_that_rebuild_the_recorded_task(tmp_path, capsys):
+    # a run recorded when the point task's doors were 0.5 wide by default: its config.json spells no option
+    run_dir = tmp_path / "run"
+    assert main([*TINY, "--iterations", "5", "--run-dir", str(run_dir), "--env-options", "door_half_width=0.5"]) == 0
+    saved = json.load(open(run_dir / "config.json"))
+    (run_dir / "config.json").write_text(json.dumps({**saved, "env_options": ""}))
+    capsys.readouterr()
+    assert main(["--resume", str(run_dir), "--iterations", "10", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    spelt = "door_half_width=0.5"
+    assert len(err.splitlines()) == 1 and err.rstrip().endswith(f"differ (door_half_width): --env-options {spelt}")
+    assert main(["--resume", str(run_dir), "--iterations", "10", "--env-options", spelt, "--quiet"]) == 0
+    assert json.load(open(run_dir / "config.json"))["env_options"] == "door_half_width=0.5"  # recorded from now on
+    assert [json.loads(x)["iteration"] for x in open(run_dir / "metrics.jsonl")] == [5, 10]
 
 
 def test_resume_to_fewer_iterations_is_refused_and_a_finished_run_is_complete(tmp_path, capsys):

@@ -160,3 +160,19 @@ def test_records_beyond_the_gap_without_a_checkpoint_are_not_dropped(tmp_path, c
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and f"invalid --resume {tmp_path}: must be a run with a checkpoint" in err
     assert (tmp_path / "metrics.jsonl").read_text() == lines
+
+
+def test_a_slide_run_from_before_the_pads_default_is_told_the_options_of_its_task():
+    import envs
+    from splid_jax.common.errors import InvalidConfig
+    from splid_jax.config import TrainConfig
+    from splid_jax.runtime.run_files import env_settings, recorded_task
+
+    was = env_settings(envs.make("slide", finger="box", finger_table=0.0, drive="pd", gripper_mass=0.0))
+    assert "gripper_mass" not in was  # as runs recorded before the option existed
+    cfg, now = TrainConfig(env="slide", run_dir="R"), env_settings(envs.make("slide"))
+    spelt = "finger=box,drive=pd,finger_table=0.0,gripper_mass=0.0"
+    named = "differ \\(finger, drive, finger_table, gripper_mass\\)"
+    with pytest.raises(InvalidConfig, match=f"{named}: --env-options {spelt}$"):
+        recorded_task(cfg, {"env": was}, now)
+    recorded_task(TrainConfig(env="slide", run_dir="R", env_options=spelt), {"env": was}, was)  # its own task: resumes
