@@ -32,10 +32,15 @@ class State:
     invalid: jax.Array  # [] bool, a NaN was seen: the episode is flagged, never silently used
 
 
+def recorded_default(field: dataclasses.Field):
+    """The value of ``field`` in a run that recorded none: its ``unrecorded`` metadata, else its default."""
+    return field.metadata.get("unrecorded", field.default)
+
+
 def _left_out_at(field: dataclasses.Field):
     """The value at which ``GoalEnv.settings`` leaves ``field`` out; a sentinel no value equals where it never is."""
     if field.metadata.get("recorded_when_set"):
-        return field.metadata.get("unrecorded", field.default)
+        return recorded_default(field)
     return field.default if field.metadata.get("numerics_only") else _ALWAYS
 
 

@@ -18,9 +18,11 @@ def loadable(cfg):
     from envs.physics import kernels_checked
     from splid_jax.common.values import format_overrides, parse_overrides
 
+    if cfg.env != "slide":
+        return cfg
     options = parse_overrides(cfg.env_options)
-    task_default = {f.name: f.default for f in dataclasses.fields(envs.task_class(cfg.env))}.get("finger")
-    if cfg.env != "slide" or options.get("finger", task_default) != "pads" or kernels_checked():
+    default = next(f.default for f in dataclasses.fields(envs.task_class(cfg.env)) if f.name == "finger")
+    if options.get("finger", default) != "pads" or kernels_checked():
         return cfg
     options["finger"] = "box"
     return dataclasses.replace(cfg, env_options=format_overrides(options))

@@ -303,10 +303,10 @@ def _check_meta(meta: dict, expect_meta: dict | None, where: str) -> None:
             raise CheckpointError(f"{where} was saved with {key}={_show(have)} but {key}={_show(want)} is expected")
 
 
-def check_meta(run_dir: str | Path, step: int, expect_meta: dict) -> None:
-    """A resume's settings against its checkpoint's, before anything is compiled: an edited config.json
-    is refused in a moment, not after the compile. A meta that cannot be read is left to ``restore``."""
-    meta = saved_meta(run_dir, step)
+def check_meta(run_dir: str | Path, step: int, expect_meta: dict, meta: dict | None) -> None:
+    """A resume's settings against its checkpoint's (``meta``, from ``saved_meta``), before anything is compiled:
+    an edited config.json is refused in a moment, not after the compile. A meta that cannot be read is left to
+    ``restore``."""
     if meta is not None:
         _check_meta(meta, expect_meta, f"checkpoint {checkpoint_dir(run_dir) / str(step)}")
 

@@ -9,6 +9,7 @@ import os
 import sys
 
 import envs
+from envs.base import recorded_default
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.common.paths import unwritable
 from splid_jax.common.values import format_overrides, parse_overrides
@@ -45,7 +46,7 @@ def identity(cfg: TrainConfig) -> dict:
     its ``unrecorded`` value (how those runs behaved), so they still resume."""
     fields = cfg.settings_fields()
     later = {
-        f.name: (f.metadata.get("unrecorded", f.default), f.default)
+        f.name: (recorded_default(f), f.default)
         for f in fields
         if f.metadata.get("recorded_when_set")
     }
@@ -142,8 +143,9 @@ def check_run_dir(cfg: TrainConfig, resume: bool, meta: dict | None = None) -> i
     if step is not None and step > cfg.iterations:
         raise InvalidConfig("iterations", cfg.iterations, f">= {step}, the iterations {cfg.run_dir} has completed")
     if step is not None and meta is not None:
-        recorded_task(cfg, checkpoint.saved_meta(cfg.run_dir, step), meta.get("env"))
-        checkpoint.check_meta(cfg.run_dir, step, meta)
+        saved = checkpoint.saved_meta(cfg.run_dir, step)  # read once for both checks
+        recorded_task(cfg, saved, meta.get("env"))
+        checkpoint.check_meta(cfg.run_dir, step, meta, saved)
     return step
 
 
@@ -160,7 +162,7 @@ def recorded_task(cfg: TrainConfig, saved: dict | None, now: dict | None) -> Non
         return
     spelt = parse_overrides(cfg.env_options)
     for k in changed:
-        spelt[k] = was[k] if k in was else fields[k].metadata.get("unrecorded", fields[k].default)
+        spelt[k] = was[k] if k in was else recorded_default(fields[k])
     why = f"the task {cfg.run_dir} was trained on, whose options differ ({', '.join(changed)})"
     raise InvalidConfig("env_options", cfg.env_options, f"{why}: --env-options {format_overrides(spelt)}")
 

@@ -161,9 +161,10 @@ def test_meta_mismatch_names_key(tmp_path):
     # keys the caller does not ask about (progress, timings) are not compared
     ck.restore(tmp_path, make_state(0), expect_meta={k: v for k, v in META.items() if k != "seed"})
     # the same check reads the meta alone, so a resume is refused before anything compiles
+    saved = ck.saved_meta(tmp_path, 1)
     with pytest.raises(ck.CheckpointError, match=r"saved with lr=0\.0003 but lr=0\.001 is expected"):
-        ck.check_meta(tmp_path, 1, {**META, "lr": 1e-3})
-    ck.check_meta(tmp_path, 1, META)
+        ck.check_meta(tmp_path, 1, {**META, "lr": 1e-3}, saved)
+    ck.check_meta(tmp_path, 1, META, saved)
 
 
 def _largest_data_file(step_dir: Path) -> Path:
