@@ -12,6 +12,7 @@ import os
 import re
 import signal
 import sys
+import tempfile
 
 _INTERRUPTED = {"when": ""}  # what a signal outside a run's own handlers cuts short, said in its line
 
@@ -310,12 +311,23 @@ def default_compile_cache() -> str:
 
 
 def _cache_dir(path: str) -> str:
-    """A directory, or a path one can be made at: JAX only warns, program by program, of one it cannot use."""
+    """A directory that programs can be written to, made here if need be: JAX would only warn, program by
+    program, of one it cannot use. The default, where it cannot be written, is turned off with a notice."""
     here = os.path.abspath(path) if path else ""
     while here and not os.path.exists(here):
         here = os.path.dirname(here)
     if here and not os.path.isdir(here):
         raise argparse.ArgumentTypeError(f"{path!r} is not a directory ({here} is a file); '' turns the cache off")
+    try:
+        if path:
+            os.makedirs(path, exist_ok=True)
+            tempfile.TemporaryFile(dir=path).close()
+    except OSError as e:
+        why = f"cannot be written ({e.strerror})"
+        if path != default_compile_cache():
+            raise argparse.ArgumentTypeError(f"{path!r} {why}; '' turns the cache off") from None
+        print(f"the compile cache {path} {why}: compiling without it", file=sys.stderr)
+        return ""
     return path
 
 

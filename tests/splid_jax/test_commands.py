@@ -64,6 +64,22 @@ def test_a_compile_cache_that_is_a_file_is_one_line_before_any_work(tmp_path, ca
     assert (tmp_path / "taken").read_text() == "kept" and not (tmp_path / "run").exists()
 
 
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux's /proc, where no directory can be made")
+def test_an_unwritable_compile_cache_is_one_line_and_the_default_is_turned_off(tmp_path, capsys, monkeypatch):
+    from splid_jax import cli, train
+
+    with pytest.raises(SystemExit) as stop:
+        train.main(["--env", "point", "--compile-cache", "/proc/splid_jax_cache", "--run-dir", str(tmp_path / "run")])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and len(err.splitlines()) == 1 and "cannot be written" in err, err
+    assert not (tmp_path / "run").exists()
+    monkeypatch.setenv("XDG_CACHE_HOME", "/proc/splid_jax_home")  # the default's parent
+    parser = cli.Parser()
+    cli.add_compile_cache_flag(parser)
+    assert parser.parse_args([]).compile_cache == ""
+    assert "compiling without it" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("args, said", [(["--hidden", "-5,4"], "invalid --hidden -5,4: must be one or more widths"),
                                         (["--sigma", "-1e-3"], "invalid --sigma -0.001: must be >= 0")])  # fmt: skip
 def test_a_negative_value_is_taken_as_the_flags_value_and_named(tmp_path, capsys, args, said):
