@@ -367,7 +367,8 @@ def start_processes(ns: argparse.Namespace) -> None:
     raise ``InvalidConfig`` before anything waits for a peer."""
     from splid_jax.runtime import multihost
 
-    multihost.start(multihost.launch(ns.coordinator, ns.num_processes, ns.process_id))
+    show = (lambda text: None) if getattr(ns, "quiet", False) else (lambda text: print(text, flush=True))
+    multihost.start(multihost.launch(ns.coordinator, ns.num_processes, ns.process_id), show)
 
 
 def exit_with(code: int) -> None:

@@ -7,10 +7,12 @@ saves it: it resumes under any process layout. With one process each function is
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
 import pickle
 import socket
+import time
 from collections.abc import Callable
 from typing import TypeVar
 
@@ -54,18 +56,18 @@ def launch(coordinator: str | None, num_processes: int | None, process_id: int |
 # later than the others: neither may count as a dead process.
 HEARTBEAT_S = 900
 JOIN_S = 900
+_NOTE_AFTER_S = 5.0  # a wait longer than this is shown
 # XLA:GPU otherwise splits autotuning across the processes, each waiting in its compile for the others'
 # results; process 0 alone compiles some programs (restoring a checkpoint), and each process its own groups.
 SOLO_AUTOTUNING = "--xla_gpu_shard_autotuning=false"
 
 
-def start(where: Launch | None) -> None:
+def start(where: Launch | None, show: Callable[[str], None] = print) -> None:
     """Joins the run's processes, before any other JAX use. The CPU backend's collectives need gloo
     (the setting is read by the CPU backend only, so it is set whatever the platform)."""
     if where is None:
         return
-    if where.process_id == 0:
-        _check_port(where.coordinator)
+    meet(where, JOIN_S, show)
     jax.config.update("jax_cpu_collectives_implementation", "gloo")
     flags = os.environ.get("XLA_FLAGS", "")
     if "xla_gpu_shard_autotuning" not in flags:
@@ -79,16 +81,81 @@ def start(where: Launch | None) -> None:
     )
 
 
-def _check_port(coordinator: str) -> None:
-    """Process 0 serves the coordinator on every interface at PORT; a port in use crashes that server
-    (a segmentation fault under jaxlib 0.10), so it is tried first, as the server binds it."""
-    with socket.socket() as probe:
-        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+def meet(where: Launch, within: float, show: Callable[[str], None] = print) -> None:
+    """Every process reaches process 0 at the coordinator's address before JAX's coordination service
+    starts. That service ends a process whose peers never come with an abort after its timeout, and
+    a port in use crashes its server (a segmentation fault under jaxlib 0.10); here either is one line
+    naming the flag. A wait of more than a few seconds is shown."""
+    start, shown = time.monotonic(), False
+
+    def waiting() -> bool:  # False once ``within`` is past
+        nonlocal shown
+        late = time.monotonic() - start
+        if late > _NOTE_AFTER_S and not shown:
+            shown = True
+            show(f"process {where.process_id} of {where.num_processes}: waiting up to {within:.0f} s for the others "
+                 f"at {where.coordinator}")  # fmt: skip
+        return late < within
+
+    (_gather if where.process_id == 0 else _reach)(where, within, waiting)
+
+
+def _reach(where: Launch, within: float, waiting: Callable[[], bool]) -> None:
+    """Process i > 0: tells process 0 its index and waits for the word to go on."""
+    host, _, port = where.coordinator.rpartition(":")
+    reply = None
+    while reply is None:
         try:
-            probe.bind(("", int(coordinator.rpartition(":")[2])))
+            with socket.create_connection((host.strip("[]"), int(port)), timeout=1.0) as conn:
+                conn.sendall(f"{where.process_id}\n".encode())
+                conn.settimeout(within + 30.0)  # process 0 gives up first, and says so by closing
+                reply = conn.makefile().readline().strip()
+        except OSError:
+            if not waiting():
+                allowed = f"HOST:PORT where process 0 of the run listens (none answered within {within:.0f} s)"
+                raise InvalidConfig("coordinator", where.coordinator, allowed) from None
+            time.sleep(0.2)
+    if reply == "taken":
+        allowed = f"an integer in [0, {where.num_processes}) that no other process of the run has (--process-id)"
+        raise InvalidConfig("process_id", where.process_id, allowed)
+    if reply != "go":
+        allowed = "HOST:PORT that every process reaches (process 0 stopped waiting for the others)"
+        raise InvalidConfig("coordinator", where.coordinator, allowed)
+
+
+def _gather(where: Launch, within: float, waiting: Callable[[], bool]) -> None:
+    """Process 0: listens on every interface at PORT, as the coordination service then does, until
+    each other index has come once; then tells them all to go on."""
+    peers: dict[int, socket.socket] = {}
+    with socket.socket() as server, contextlib.ExitStack() as closing:
+        server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            server.bind(("", int(where.coordinator.rpartition(":")[2])))
         except OSError as e:
             allowed = f"HOST:PORT with a port free on process 0 ({e.strerror})"
-            raise InvalidConfig("coordinator", coordinator, allowed) from None
+            raise InvalidConfig("coordinator", where.coordinator, allowed) from None
+        server.listen()
+        server.settimeout(0.2)
+        while len(peers) < where.num_processes - 1:
+            if not waiting():
+                missing = ", ".join(str(i) for i in range(1, where.num_processes) if i not in peers)
+                allowed = f"HOST:PORT that every process reaches (process {missing} did not within {within:.0f} s)"
+                raise InvalidConfig("coordinator", where.coordinator, allowed)
+            try:
+                conn = closing.enter_context(server.accept()[0])
+                conn.settimeout(5.0)
+                i = int(conn.makefile().readline())
+            except (OSError, ValueError):  # no one came, or not a process of this run
+                continue
+            if i in peers or not 0 < i < where.num_processes:
+                conn.sendall(b"taken\n")
+            else:
+                peers[i] = conn
+        for conn in peers.values():
+            conn.sendall(b"go\n")
+        for conn in peers.values():  # each peer closes first, so no closed port waits on process 0
+            with contextlib.suppress(OSError):
+                conn.recv(1)
 
 
 def is_first() -> bool:
