@@ -93,7 +93,7 @@ def meet(where: Launch, within: float, show: Callable[[str], None] = print) -> N
         late = time.monotonic() - start
         if late > _NOTE_AFTER_S and not shown:
             shown = True
-            show(f"process {where.process_id} of {where.num_processes}: waiting up to {within:.0f} s for the others "
+            show(f"process {where.process_id} of {where.num_processes}: waiting up to {within:g} s for the others "
                  f"at {where.coordinator}")  # fmt: skip
         return late < within
 
@@ -112,7 +112,7 @@ def _reach(where: Launch, within: float, waiting: Callable[[], bool]) -> None:
                 reply = conn.makefile().readline().strip()
         except OSError:
             if not waiting():
-                allowed = f"HOST:PORT where process 0 of the run listens (none answered within {within:.0f} s)"
+                allowed = f"HOST:PORT where process 0 of the run listens (none answered within {within:g} s)"
                 raise InvalidConfig("coordinator", where.coordinator, allowed) from None
             time.sleep(0.2)
     if reply == "taken":
@@ -139,7 +139,7 @@ def _gather(where: Launch, within: float, waiting: Callable[[], bool]) -> None:
         while len(peers) < where.num_processes - 1:
             if not waiting():
                 missing = ", ".join(str(i) for i in range(1, where.num_processes) if i not in peers)
-                allowed = f"HOST:PORT that every process reaches (process {missing} did not within {within:.0f} s)"
+                allowed = f"HOST:PORT that every process reaches (process {missing} did not within {within:g} s)"
                 raise InvalidConfig("coordinator", where.coordinator, allowed)
             try:
                 conn = closing.enter_context(server.accept()[0])

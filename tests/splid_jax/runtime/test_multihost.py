@@ -157,7 +157,7 @@ def meet_all(port: int, ids, within: float = 10.0) -> tuple[list, list]:
     threads = [threading.Thread(target=one, args=(k,)) for k in range(len(ids))]
     for t in threads:
         t.start()
-        time.sleep(0.3)  # process 0 first or last alike: the others retry
+        time.sleep(0.1)  # process 0 first or last alike: the others retry
     for t in threads:
         t.join(timeout=30)
     return out, shown
@@ -168,14 +168,14 @@ def test_the_processes_meet_at_process_0_before_jax_joins_them():
 
 
 def test_a_process_that_never_comes_or_a_taken_index_is_one_line_not_a_crash(monkeypatch):
-    monkeypatch.setattr(multihost, "_NOTE_AFTER_S", 0.5)
+    monkeypatch.setattr(multihost, "_NOTE_AFTER_S", 0.3)
     port = free_port()
-    (first, second), shown = meet_all(port, [0, 1], within=2.0)  # process 2 never starts
+    (first, second), shown = meet_all(port, [0, 1], within=1.0)  # process 2 never starts
     assert first == (f"invalid coordinator='127.0.0.1:{port}': must be HOST:PORT that every process reaches "
-                     "(process 2 did not within 2 s)")  # fmt: skip
+                     "(process 2 did not within 1 s)")  # fmt: skip
     assert second.endswith("(process 0 stopped waiting for the others)")
-    assert "waiting up to 2 s for the others" in shown[0]
-    assert "none answered within 1 s" in meet_all(free_port(), [2], within=1.0)[0][0]  # no process 0
+    assert "waiting up to 1 s for the others" in shown[0]
+    assert "none answered within 0.5 s" in meet_all(free_port(), [2], within=0.5)[0][0]  # no process 0
     twice, _ = meet_all(free_port(), [0, 1, 1, 2])
     assert twice[:2] == [None, None] and twice[3] is None
     assert twice[2].startswith("invalid process_id=1: must be an integer in [0, 3) that no other process of the run")
