@@ -313,15 +313,16 @@ def default_compile_cache() -> str:
 def _cache_dir(path: str) -> str:
     """A directory that programs can be written to, made here if need be: JAX would only warn, program by
     program, of one it cannot use. The default, where it cannot be written, is turned off with a notice."""
-    here = os.path.abspath(path) if path else ""
-    while here and not os.path.exists(here):
+    if not path:
+        return path
+    here = os.path.abspath(path)
+    while not os.path.exists(here):
         here = os.path.dirname(here)
-    if here and not os.path.isdir(here):
+    if not os.path.isdir(here):
         raise argparse.ArgumentTypeError(f"{path!r} is not a directory ({here} is a file); '' turns the cache off")
     try:
-        if path:
-            os.makedirs(path, exist_ok=True)
-            tempfile.TemporaryFile(dir=path).close()
+        os.makedirs(path, exist_ok=True)
+        tempfile.TemporaryFile(dir=path).close()
     except OSError as e:
         why = f"cannot be written ({e.strerror})"
         if path != default_compile_cache():
