@@ -33,6 +33,12 @@ class Launch:
     num_processes: int
     process_id: int
 
+    @property
+    def address(self) -> tuple[str, int]:
+        """The coordinator's host (an IPv6 one without its brackets) and port."""
+        host, _, port = self.coordinator.rpartition(":")
+        return host.strip("[]"), int(port)
+
 
 def launch(coordinator: str | None, num_processes: int | None, process_id: int | None) -> Launch | None:
     """The checked launch options; None for a run of one process, which has nothing to join."""
@@ -102,11 +108,10 @@ def meet(where: Launch, within: float, show: Callable[[str], None] = print) -> N
 
 def _reach(where: Launch, within: float, waiting: Callable[[], bool]) -> None:
     """Process i > 0: tells process 0 its index and waits for the word to go on."""
-    host, _, port = where.coordinator.rpartition(":")
     reply = None
     while reply is None:
         try:
-            with socket.create_connection((host.strip("[]"), int(port)), timeout=1.0) as conn:
+            with socket.create_connection(where.address, timeout=1.0) as conn:
                 conn.sendall(f"{where.process_id}\n".encode())
                 conn.settimeout(within + 30.0)  # process 0 gives up first, and says so by closing
                 reply = conn.makefile().readline().strip()
@@ -130,7 +135,7 @@ def _gather(where: Launch, within: float, waiting: Callable[[], bool]) -> None:
     with socket.socket() as server, contextlib.ExitStack() as closing:
         server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
-            server.bind(("", int(where.coordinator.rpartition(":")[2])))
+            server.bind(("", where.address[1]))
         except OSError as e:
             allowed = f"HOST:PORT with a port free on process 0 ({e.strerror})"
             raise InvalidConfig("coordinator", where.coordinator, allowed) from None
