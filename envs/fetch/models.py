@@ -161,6 +161,7 @@ def mjcf(
     drive: str = "pd",
     finger_table: float = 0.0,
     finger_drive: str = "reference",
+    hand_pitch: float = 0.0,
 ) -> str:
     """The MJCF text of task ``kind`` (one of ``KINDS``); ``table`` is the table's collision shape
     (``tables_for(kind)``), ``finger`` the closed finger block's (``fingers_for(kind)``).
@@ -181,7 +182,8 @@ def mjcf(
     below the grip site and touch the table with this friction (condim 3), so a gripper driven down at
     the table presses on it and drags, as the reference's does under its mocap weld; 0: no such contact.
 
-    ``finger_drive`` (PickAndPlace's free fingers): one of ``FINGER_DRIVES``, see there."""
+    ``finger_drive`` (PickAndPlace's free fingers): one of ``FINGER_DRIVES``, see there. ``hand_pitch`` (Slide's
+    pads): a custom numeric by which ``envs/fetch/hand_pitch.py`` pitches them as the reference arm stretches."""
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
     if table not in tables_for(kind):
@@ -200,6 +202,8 @@ def mjcf(
         raise ValueError(f"finger_drive must be one of {FINGER_DRIVES}, got {finger_drive!r}")
     if finger_table < 0:
         raise ValueError(f"finger_table must be >= 0, got {finger_table}")
+    if hand_pitch and not (kind == "slide" and finger == "pads" and hand_pitch > 0):
+        raise ValueError(f"hand_pitch must be 0 but on Slide's pads, and > 0 there, got {hand_pitch}")
     (tx, ty, tz), (hx, hy, hz), (gx, gy, gz) = _SCENES[kind]
     has_object = kind != "reach"
     free_fingers = kind == "pick_and_place"
@@ -303,8 +307,9 @@ def mjcf(
             for n in names
         )
 
+    custom = f'\n  <custom><numeric name="hand_pitch" data="{hand_pitch:.6g}"/></custom>' if hand_pitch else ""
     return f"""<mujoco model="fetch_{kind}">
-  <compiler angle="radian" autolimits="true"/>
+  <compiler angle="radian" autolimits="true"/>{custom}
   <option timestep="{timestep:.6g}" integrator="Euler" solver="Newton" iterations="{iterations}"
           ls_iterations="{ls_iterations}" cone="pyramidal"/>
   <worldbody>
@@ -343,8 +348,9 @@ def own_contacts(m: mujoco.MjModel):
     """The block within which MJX knows the contacts model ``m`` needs and it lacks (box-cylinder:
     ``envs/box_cylinder.py``); put_model, make_data and a step's trace of ``m`` must run inside it."""
     from envs import box_cylinder
+    from envs.fetch import hand_pitch
 
-    groups = box_cylinder.groups_for(m)
+    groups = hand_pitch.wrap(m, box_cylinder.groups_for(m))
     if not groups:
         return contextlib.nullcontext()
     from envs import mjx_patch

@@ -15,17 +15,12 @@ control, which ``Physics`` holds (with ``drive="weld"``, ``simulate`` puts a moc
 Newton solver's warm start. Restoring a saved ``State`` and replaying the same actions reproduces the
 trajectory bit for bit, which SELECT's restore-and-replay relies on.
 
-Defaults: 10 substeps of 4 ms (the reference takes 20 of 2 ms) and Newton with 4 iterations and 4
-line-search iterations (Slide: 10, since with 4 a resting low-friction puck crept in float32 MJX).
-That halves the physics cost and keeps the scripted controllers' success; coarser steps or fewer
-iterations change what SPLID learns (``experiments/NOTES.md``). All are task fields (``timestep``,
-``substeps``, ``iterations``, ``ls_iterations``).
+Defaults (task fields): 10 substeps of 4 ms (the reference takes 20 of 2 ms), Newton with 4 iterations and 4
+line-search iterations (Slide: 10; with 4 a resting low-friction puck crept in float32 MJX): half the physics cost,
+the scripted controllers' success kept; coarser steps change what SPLID learns (``experiments/NOTES.md``).
 
-The task's ``physics`` picks the code that steps MJX: ``kernels`` (the default) with parts of the
-step replaced by faster equivalents equal to float rounding (``envs/fetch/kernels.py``: MJX's small
-dense Cholesky solves unrolled, and on a GPU the solve and box contacts as Pallas kernels), or
-``mjx``, MJX as it is. A MuJoCo release the kernels were not checked on runs ``mjx``
-(``envs/physics.py``).
+``physics``: ``kernels`` (the default), parts of the step replaced by equivalents equal to float rounding
+(``envs/fetch/kernels.py``), or ``mjx`` as it is, which a MuJoCo the kernels were not checked on runs.
 """
 
 from __future__ import annotations
@@ -108,6 +103,8 @@ class _FetchTask(GoalEnv):
     # The gripper's mass in kg (0: the task's, models.mjcf): how hard the weld drive presses (Slide's pads sink
     # into the puck as deep as the reference's at 22 kg, its arm's effective mass along z at the grip site)
     gripper_mass: float = experimental(0.0, recorded_when_set=True)
+    # Slide's pads pitched back as the reference arm stretches, by this fraction of its hand's tilt (hand_pitch.py)
+    hand_pitch: float = experimental(0.0, recorded_when_set=True)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -148,6 +145,8 @@ class _FetchTask(GoalEnv):
         check(0 <= self.floor_clearance <= 0.1, f"{n}.floor_clearance", self.floor_clearance, "in [0, 0.1] m")
         check(0 <= self.finger_table <= 2, f"{n}.finger_table", self.finger_table, "in [0, 2]")
         check(0 <= self.gripper_mass <= 100, f"{n}.gripper_mass", self.gripper_mass, "in [0, 100] kg (0: the task's)")
+        ok = self.hand_pitch == 0 or (n == "slide" and self.finger == "pads" and 0 < self.hand_pitch <= 2)
+        check(ok, f"{n}.hand_pitch", self.hand_pitch, "0, or in (0, 2] on Slide with finger=pads")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -178,6 +177,7 @@ class _FetchTask(GoalEnv):
             drive=str(self.drive),
             finger_table=float(self.finger_table),
             **({"gripper_mass": float(self.gripper_mass)} if self.gripper_mass else {}),
+            **({"hand_pitch": float(self.hand_pitch)} if self.hand_pitch else {}),
         )
 
     @property
