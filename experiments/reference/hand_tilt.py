@@ -6,8 +6,8 @@ Part one drives the reference gripper at table height and above, in five directi
 the hand's tilt (the angle of its initially vertical axis from the vertical) against the grip site's distance from
 the arm's reach centre (``envs.fetch.control.ARM_REACH_CENTER``), with the tilt's share along the radial direction.
 Part two (``--run``) plays a Slide policy there, steered as its evaluations were, and counts per step whether the
-pads press the puck (a pad-puck contact with the grip above the puck's centre), the tilt and reach then, and the
-escapes (pressed, then the grip below the puck's top at the next step).
+pads press the puck (a pad-puck contact with the grip above the puck's centre), the tilt, reach and the pads' normal
+force on the puck then, and the escapes (pressed, then the grip below the puck's top at the next step).
 """
 
 from __future__ import annotations
@@ -57,14 +57,19 @@ class Hand:
         grip = self.d.site_xpos[self.grip].copy()
         off = grip - CENTER
         radial = off[:2] / np.linalg.norm(off[:2])
-        pairs = ({c.geom1, c.geom2} for c in self.d.contact[: self.d.ncon])
-        contacts = sum(1 for g in pairs if g & self.pads and self.puck in g)
+        pairs = [i for i, c in enumerate(self.d.contact[: self.d.ncon]) if {c.geom1, c.geom2} & self.pads
+                 and self.puck in {c.geom1, c.geom2}]  # fmt: skip
+        contacts, force, f6 = len(pairs), 0.0, np.zeros(6)
+        for i in pairs:
+            self.mj.mj_contactForce(self.m, self.d, i, f6)
+            force += f6[0]
         puck = self.d.xpos[self.m.geom_bodyid[self.puck]]
         return dict(
             reach=float(np.linalg.norm(off)),
             tilt=float(np.degrees(np.arccos(min(1.0, abs(axis[2]))))),
             along=float(axis[:2] @ radial),  # < 0: the fingertips swing back toward the robot
             pressed=bool(contacts and grip[2] - puck[2] > 0.01),
+            force=float(force),  # the pads' normal force on the puck (N)
             below=bool(grip[2] - puck[2] < 0.01),
         )
 
@@ -86,6 +91,7 @@ def by_reach(rows: list[dict], select=None) -> list[dict]:
     reach = np.array([r["reach"] for r in rows])
     tilt = np.array([r["tilt"] for r in rows])
     along = np.array([r["along"] for r in rows])
+    force = np.array([r["force"] for r in rows])
     keep = np.ones(len(rows), bool) if select is None else np.asarray(select)
     out = []
     for lo, hi in zip(BINS[:-1], BINS[1:], strict=True):
@@ -98,6 +104,7 @@ def by_reach(rows: list[dict], select=None) -> list[dict]:
                     n=int(s.sum()),
                     tilt_q10_q50_q90=[round(float(q), 1) for q in (q10, q50, q90)],
                     along=round(float(np.median(along[s])), 3),
+                    force_q50=round(float(np.median(force[s])), 1),
                 )
             )
     return out
