@@ -104,7 +104,7 @@ class _FetchTask(GoalEnv):
     # into the puck as deep as the reference's at 22 kg, its arm's effective mass along z at the grip site)
     gripper_mass: float = experimental(0.0, recorded_when_set=True)
     # Slide's pads pitched back as the reference arm stretches, by this fraction of its hand's tilt (hand_pitch.py)
-    hand_pitch: float = experimental(0.0, recorded_when_set=True)
+    hand_pitch: float = experimental(0.0, recorded_when_set=True, unrecorded=0.0)
 
     kind = ""  # models.KINDS entry
     has_object = True

@@ -34,9 +34,16 @@ def note_task_changes(run_dir: str, saved: dict, env: envs.GoalEnv) -> None:
     """Name, on stderr, the task's options that differ from those a checkpoint recorded (``saved``): a
     policy is still worth a look under a changed task, so loaders say it rather than stop."""
     now = env_settings(env)
-    changed = [k for k in now if saved.get(k) != now[k]]
+    fields = {f.name: f for f in dataclasses.fields(env)}
+
+    def value(settings: dict, k: str):  # an option left out of the settings is at its recorded default
+        if k in settings or k not in fields:
+            return settings.get(k)
+        return json.loads(json.dumps(recorded_default(fields[k])))
+
+    changed = [k for k in {**saved, **now} if value(saved, k) != value(now, k)]
     if changed:
-        what = ", ".join(f"{k}={saved.get(k)!r} then, {now[k]!r} now" for k in changed)
+        what = ", ".join(f"{k}={value(saved, k)!r} then, {value(now, k)!r} now" for k in changed)
         print(f"note: {run_dir} was trained on another version of the task ({what})", file=sys.stderr)
 
 

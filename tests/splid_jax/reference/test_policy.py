@@ -48,3 +48,9 @@ def test_a_sweep_member_trained_on_another_version_of_the_task_says_so(tmp_path,
     sweep, _ = _sweep(tmp_path, trained_env=make_env("reach", finger_table=1.0))
     policy.load_run(str(sweep / "m0"))
     assert "another version of the task (finger_table=1.0 then, 0.0 now)" in capsys.readouterr().err
+    # an option recorded only when set (gripper_mass) is named both ways: set then, and set now only
+    later = _sweep(tmp_path / "later", trained_env=make_env("reach", gripper_mass=5.0))[0]
+    policy.load_run(str(later / "m0"))
+    assert "another version of the task (gripper_mass=5.0 then, 0.0 now)" in capsys.readouterr().err
+    policy.load_run(str(sweep / "m0"), env_options="gripper_mass=5")
+    assert "gripper_mass=0.0 then, 5.0 now" in capsys.readouterr().err
