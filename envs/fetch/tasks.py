@@ -96,9 +96,8 @@ class _FetchTask(GoalEnv):
     # How far above the fingertips-on-the-table height the gripper target may go down (m); the reference's
     # longer fingers meet its table 0.01 m higher than ours.
     floor_clearance: float = experimental(0.0)
-    # Friction of a contact between the fingers and the table (models.mjcf's finger_table); 0: none. With it
-    # the fingers are as long as the reference's and a gripper driven down at the table presses and drags.
-    # Push: 1 (the reference's), the others 0.
+    # Friction of a contact between the fingers and the table (models.mjcf's finger_table; 0: none, Push's 1 the
+    # reference's): the fingers as long as the reference's, so a gripper driven down at the table presses and drags.
     finger_table: float = experimental(0.0)
     # The gripper's mass in kg (0: the task's, models.mjcf): how hard the weld drive presses (Slide's pads sink
     # into the puck as deep as the reference's at 22 kg, its arm's effective mass along z at the grip site)
@@ -146,7 +145,7 @@ class _FetchTask(GoalEnv):
         check(0 <= self.finger_table <= 2, f"{n}.finger_table", self.finger_table, "in [0, 2]")
         check(0 <= self.gripper_mass <= 100, f"{n}.gripper_mass", self.gripper_mass, "in [0, 100] kg (0: the task's)")
         ok = self.hand_pitch == 0 or (n == "slide" and self.finger == "pads" and 0 < self.hand_pitch <= 2)
-        check(ok, f"{n}.hand_pitch", self.hand_pitch, "0, or in (0, 2] on Slide with finger=pads")
+        check(ok, f"{n}.hand_pitch", self.hand_pitch, "in (0, 2] on Slide's pads, else 0 (with finger=box: 0)")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -351,15 +350,16 @@ class Push(_FetchTask):
 class Slide(_FetchTask):
     """Strike a low-friction puck (a cylinder on a plane table top, see models.py) to a goal 0.4 m ahead,
     out of reach. The fingers are the reference's: box pads (``finger="pads"``, a box-cylinder contact MJX
-    lacks, envs/fetch/slide_fingers.py) that touch the table, moved by the reference's weld law with its
-    arm's effective mass: round fingertips let a policy ride the puck on its top face, a strategy the
-    reference does not allow, so their policies failed there (experiments/NOTES.md, "Slide with the
-    reference's pads")."""
+    lacks, envs/fetch/slide_fingers.py) that touch the table, pitch back as its hand does at stretch
+    (``hand_pitch``), moved by its weld law with its arm's effective mass: round fingertips let a policy ride
+    the puck, which the reference does not allow, so their policies failed there (experiments/NOTES.md,
+    "Slide with the reference's pads", "The hand's pitch")."""
 
     finger: str = "pads"
     finger_table: float = 1.0
     drive: str = "weld"
     gripper_mass: float = dataclasses.field(default=22.0, metadata={"recorded_when_set": True, "unrecorded": 0.0})
+    hand_pitch: float = dataclasses.field(default=1.0, metadata={"recorded_when_set": True, "unrecorded": 0.0})
     obj_range: float = 0.1
     target_range: float = 0.3
     iterations: int = 10  # 4 let a resting low-friction puck creep in float32 (up to 10 cm in 50 steps)

@@ -25,7 +25,7 @@ def loadable(cfg):
     if options.get("finger", default) != "pads" or kernels_checked():
         return cfg
     options["finger"] = "box"
-    options.pop("hand_pitch", None)  # the pads' alone
+    options["hand_pitch"] = 0.0  # the pads' alone
     return dataclasses.replace(cfg, env_options=format_overrides(options))
 
 

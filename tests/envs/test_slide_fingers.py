@@ -48,9 +48,11 @@ def test_the_box_cylinder_entry_lives_only_while_mjx_uses_it():
 def test_the_reference_pads_are_slides_default():
     task = envs.make("slide")
     assert (task.finger, task.finger_table, task.drive, task.gripper_mass) == ("pads", 1.0, "weld", 22.0)
+    assert task.hand_pitch == 1.0 and task.settings()["hand_pitch"] == 1.0  # the reference hand's tilt, recorded
     names = {task.mj_model.geom(i).name for i in range(task.mj_model.ngeom)}
     assert {"pad_r", "pad_l"} <= names and not {"tip_0", "tip_3"} & names
-    m = envs.make("slide", finger="box", finger_table=0.0, drive="pd", gripper_mass=0.0).mj_model  # the former task
+    former = dict(finger="box", finger_table=0.0, drive="pd", gripper_mass=0.0, hand_pitch=0.0)
+    m = envs.make("slide", **former).mj_model  # the former task
     assert {"tip_0", "tip_3"} <= {m.geom(i).name for i in range(m.ngeom)}
 
 

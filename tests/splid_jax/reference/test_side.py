@@ -11,8 +11,8 @@ def test_pads_load_with_the_box_fingers_inputs_only_off_the_kernels_release(monk
     assert side.loadable(cfg) is cfg  # the release the pads were checked on builds them
     monkeypatch.setattr(envs.physics, "kernels_checked", lambda: False)
     other = side.loadable(cfg)
-    assert other.env_options == "finger=box,finger_table=1,drive=weld" and other.env == "slide"
+    assert other.env_options == "finger=box,finger_table=1,drive=weld,hand_pitch=0.0" and other.env == "slide"
     default = side.loadable(TrainConfig(env="slide"))  # Slide's default fingers are the pads
-    assert default.env_options == "finger=box"
+    assert default.env_options == "finger=box,hand_pitch=0.0"
     plain = TrainConfig(env="push", env_options="drive=weld")
     assert side.loadable(plain) is plain

@@ -168,11 +168,11 @@ def test_a_slide_run_from_before_the_pads_default_is_told_the_options_of_its_tas
     from splid_jax.config import TrainConfig
     from splid_jax.runtime.run_files import env_settings, recorded_task
 
-    was = env_settings(envs.make("slide", finger="box", finger_table=0.0, drive="pd", gripper_mass=0.0))
-    assert "gripper_mass" not in was  # as runs recorded before the option existed
+    was = env_settings(envs.make("slide", finger="box", finger_table=0.0, drive="pd", gripper_mass=0.0, hand_pitch=0.0))
+    assert "gripper_mass" not in was and "hand_pitch" not in was  # as runs recorded before the option existed
     cfg, now = TrainConfig(env="slide", run_dir="R"), env_settings(envs.make("slide"))
-    spelt = "finger=box,drive=pd,finger_table=0.0,gripper_mass=0.0"
-    named = "differ \\(finger, drive, finger_table, gripper_mass\\)"
+    spelt = "finger=box,drive=pd,finger_table=0.0,gripper_mass=0.0,hand_pitch=0.0"
+    named = "differ \\(finger, drive, finger_table, gripper_mass, hand_pitch\\)"
     with pytest.raises(InvalidConfig, match=f"{named}: --env-options {spelt}$"):
         recorded_task(cfg, {"env": was}, now)
     recorded_task(TrainConfig(env="slide", run_dir="R", env_options=spelt), {"env": was}, was)  # its own task: resumes
