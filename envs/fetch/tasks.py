@@ -5,19 +5,17 @@ observation in the reference's order (10 for Reach), achieved goal = object posi
 for Reach), sparse reward ``-(d > threshold)``, 50-step episodes, action ``a`` in [-1, 1]^4 moving
 the gripper target by ``0.05 * a[:3]`` per 0.04 s control step.
 
-Gripper target: as in the reference, the *current* grip position plus ``0.05 * a[:3]``, clipped to
-a workspace box whose floor keeps the fingertips at or above the table (with ``finger_table`` the
-floor lies 2.5 cm lower and the fingers' contact with the table holds them), then within the reference
-arm's reach (``control.within_reach``; ``workspace="box"`` drops it). The target is the actuator
-control, which ``Physics`` holds (with ``drive="weld"``, ``simulate`` puts a mocap body there).
+Gripper target: as in the reference, the *current* grip position plus ``0.05 * a[:3]``, clipped to a workspace
+box whose floor keeps the fingertips at or above the table (with ``finger_table`` 2.5 cm lower, where the fingers'
+contact with the table holds them), then within the arm's reach (``control``; ``workspace="box"`` drops it): the
+actuator control, which ``Physics`` holds (with ``drive="weld"``, ``simulate`` puts a mocap body there).
 
 ``State.physics`` (a ``Physics``) is the complete simulator state: qpos, qvel, ctrl, time and the
 Newton solver's warm start. Restoring a saved ``State`` and replaying the same actions reproduces the
 trajectory bit for bit, which SELECT's restore-and-replay relies on.
 
-Defaults (task fields): 10 substeps of 4 ms (the reference takes 20 of 2 ms), Newton with 4 iterations and 4
-line-search iterations (Slide: 10; with 4 a resting low-friction puck crept in float32 MJX): half the physics cost,
-the scripted controllers' success kept; coarser steps change what SPLID learns (``experiments/NOTES.md``).
+Defaults: 10 substeps of 4 ms (the reference's 20 of 2 ms), Newton with 4 iterations and 4 line-search iterations
+(Slide: 10; with 4 a resting puck crept in float32): half the physics cost, the scripted controllers' success kept.
 
 ``physics``: ``kernels`` (the default), parts of the step replaced by equivalents equal to float rounding
 (``envs/fetch/kernels.py``), or ``mjx`` as it is, which a MuJoCo the kernels were not checked on runs.
@@ -83,8 +81,7 @@ class _FetchTask(GoalEnv):
     # (fused; on a GPU only: gpu-fused; envs/fused_collision.py): the same contacts up to MJX's float ties
     collision: str = experimental("mjx", numerics_only=True)
     # GPU warps per env in the physics kernels above (Triton's default is 4): an env's solve is a chain of small
-    # reductions, which one warp runs without crossing warps (experiments/NOTES.md, "Physics kernels, HER's updates
-    # and the host loop")
+    # reductions, which one warp runs without crossing warps (experiments/NOTES.md, "Physics kernels, HER's updates")
     kernel_warps: int = experimental(1, numerics_only=True)
     # where the gripper target may go: the box and the reference arm's reach, or the box
     workspace: str = experimental("arm")
@@ -93,8 +90,7 @@ class _FetchTask(GoalEnv):
     # Training only (experimental): this share of resets starts with the object between the closed fingers
     # (PickAndPlace), HER 2017's protocol; evaluation_task() resets it to 0: success is measured from standard starts.
     grasped_starts: float = experimental(0.0)
-    # How far above the fingertips-on-the-table height the gripper target may go down (m); the reference's
-    # longer fingers meet its table 0.01 m higher than ours.
+    # How far above the fingertips-on-the-table height the gripper target may go down (m; the reference's 0.01)
     floor_clearance: float = experimental(0.0)
     # Friction of a contact between the fingers and the table (models.mjcf's finger_table; 0: none, Push's 1 the
     # reference's): the fingers as long as the reference's, so a gripper driven down at the table presses and drags.
@@ -104,6 +100,8 @@ class _FetchTask(GoalEnv):
     gripper_mass: float = experimental(0.0, recorded_when_set=True)
     # Slide's pads pitched back as the reference arm stretches, by this fraction of its hand's tilt (hand_pitch.py)
     hand_pitch: float = experimental(0.0, recorded_when_set=True, unrecorded=0.0)
+    # Slide: this fraction of the share of the pull down the reference's straightening arm takes (control.py)
+    press_share: float = experimental(0.0, recorded_when_set=True, unrecorded=0.0)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -146,6 +144,8 @@ class _FetchTask(GoalEnv):
         check(0 <= self.gripper_mass <= 100, f"{n}.gripper_mass", self.gripper_mass, "in [0, 100] kg (0: the task's)")
         ok = self.hand_pitch == 0 or (n == "slide" and self.finger == "pads" and 0 < self.hand_pitch <= 2)
         check(ok, f"{n}.hand_pitch", self.hand_pitch, "in (0, 2] on Slide's pads, else 0 (with finger=box: 0)")
+        ok = self.press_share == 0 or (n == "slide" and self.workspace == "arm" and 0 < self.press_share <= 1)
+        check(ok, f"{n}.press_share", self.press_share, "in (0, 1] on Slide in the arm's workspace, else 0")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -267,7 +267,7 @@ class _FetchTask(GoalEnv):
         reach = lay.reach_center if self.workspace == "arm" else None
         lo = (*lay.workspace_lo[:2], lay.workspace_lo[2] + self.floor_clearance)
         target = control.gripper_target(phys.qpos[g : g + 3], action[:3], lay.grip_home, lo,
-                                       lay.workspace_hi, reach, xp=jnp)  # fmt: skip
+                                       lay.workspace_hi, reach, xp=jnp, press=self.press_share)  # fmt: skip
         ctrl = phys.ctrl.at[0:3].set(target)
         if lay.finger_q is not None:
             f = lay.finger_q
