@@ -98,6 +98,23 @@ def test_tilted_box_on_the_top_face():
     assert np.all(normal @ c_normal[0] > np.cos(0.06))
 
 
+@pytest.mark.parametrize("degrees", (10, 20, 30))
+def test_pitched_pad_edge_on_the_top_face_as_mujoco_c(degrees):
+    """Slide's pads pitched as the reference hand at stretch (``hand_pitch``) press the cap with an edge: the cap's
+    normal and the edge's depth, as MuJoCo C's."""
+    t = np.radians(degrees)
+    low = PAD[2] * np.cos(t) + PAD[0] * np.sin(t)  # the turned box's lowest edge below its centre
+    for x in (0.0, 0.01):
+        c_dist, c_pos, c_normal, poses = _mujoco((x, 0.0, PUCK[1] + low - 5e-4), (0, t, 0))
+        dist, pos, normal = _contacts(poses)
+        assert len(dist) >= 1 and len(c_dist) >= 1
+        np.testing.assert_allclose(normal, np.broadcast_to(c_normal[0], normal.shape), atol=0.01)
+        np.testing.assert_allclose(dist, c_dist[0], atol=2e-5)
+        # on the edge's line; where along it each puts its one point is its own choice
+        np.testing.assert_allclose(pos[:, [0, 2]], np.broadcast_to(c_pos[0, [0, 2]], (len(pos), 2)), atol=5e-4)
+        assert np.all(np.abs(pos[:, 1]) <= PAD[1]) and np.all(np.abs(c_pos[:, 1]) <= PAD[1])
+
+
 def test_tilted_puck_under_a_level_box():
     c_dist, c_pos, c_normal, poses = _mujoco((0.0, 0.0, 0.0575), cyl_euler=(0.1, 0, 0))
     dist, pos, normal = _contacts(poses)
