@@ -143,7 +143,7 @@ class _FetchTask(GoalEnv):
         check(0 <= self.finger_table <= 2, f"{n}.finger_table", self.finger_table, "in [0, 2]")
         check(0 <= self.gripper_mass <= 100, f"{n}.gripper_mass", self.gripper_mass, "in [0, 100] kg (0: the task's)")
         ok = self.hand_pitch == 0 or (n == "slide" and self.finger == "pads" and 0 < self.hand_pitch <= 2)
-        check(ok, f"{n}.hand_pitch", self.hand_pitch, "in (0, 2] on Slide's pads, else 0 (with finger=box: 0)")
+        check(ok, f"{n}.hand_pitch", self.hand_pitch, "0 off Slide's pads (finger=box: add hand_pitch=0), else (0, 2]")
         ok = self.press_share == 0 or (n == "slide" and self.workspace == "arm" and 0 < self.press_share <= 1)
         check(ok, f"{n}.press_share", self.press_share, "in (0, 1] on Slide in the arm's workspace, else 0")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
