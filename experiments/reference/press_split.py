@@ -23,24 +23,18 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", ".."))
 from hand_tilt import BINS, Hand  # noqa: E402
 
 
-def split(hand: Hand) -> dict:
-    """The step's weld pull along z (N, + up on the hand), the pads' normal force on the puck and on the table (N),
-    and the arm's joint limits engaged (name: constraint force)."""
+def split(hand: Hand, table: set[int], weld: int) -> dict:
+    """The step's weld pull along z (N, + up on the hand), the pads' normal force on the table (N; on the puck:
+    ``Hand.read``'s ``force``), and the arm's joint limits engaged (name: constraint force). ``table``: the table's
+    geoms; ``weld``: the mocap weld's equality id."""
     mj, m, d = hand.mj, hand.m, hand.d
-    table = {g for g in range(m.ngeom) if m.geom_bodyid[g] != 0 and mj.mj_id2name(m, mj.mjtObj.mjOBJ_BODY,
-             m.geom_bodyid[g]) == "table0"}  # fmt: skip
-    on_puck = on_table = 0.0
+    on_table = 0.0
     f6 = np.zeros(6)
     for i, c in enumerate(d.contact[: d.ncon]):
         pair = {c.geom1, c.geom2}
-        if not pair & hand.pads:
-            continue
-        mj.mj_contactForce(m, d, i, f6)
-        if hand.puck in pair:
-            on_puck += f6[0]
-        elif pair & table:
+        if pair & hand.pads and pair & table and hand.puck not in pair:
+            mj.mj_contactForce(m, d, i, f6)
             on_table += f6[0]
-    weld = int(np.flatnonzero(m.eq_type == mj.mjtEq.mjEQ_WELD)[0])
     rows = [r for r in range(d.nefc) if d.efc_type[r] == mj.mjtConstraint.mjCNSTR_EQUALITY and d.efc_id[r] == weld]
     # the weld's rows are body1 (the mocap) minus body2 (the hand) in world axes: the hand feels minus their force
     weld_z = -float(d.efc_force[rows[2]]) if len(rows) >= 3 else 0.0
@@ -49,7 +43,7 @@ def split(hand: Hand) -> dict:
         for r in range(d.nefc)
         if d.efc_type[r] == mj.mjtConstraint.mjCNSTR_LIMIT_JOINT
     }
-    return dict(on_puck=float(on_puck), on_table=float(on_table), weld_z=weld_z, limits=limits)
+    return dict(on_table=float(on_table), weld_z=weld_z, limits=limits)
 
 
 def median(steps: list[dict], key: str) -> float:
@@ -66,6 +60,8 @@ def main() -> int:
     from splid_jax.reference.side import loadable
 
     hand = Hand()
+    table = set(np.flatnonzero(hand.m.geom_bodyid == hand.m.body("table0").id).tolist())
+    weld = int(np.flatnonzero(hand.m.eq_type == hand.mj.mjtEq.mjEQ_WELD)[0])
     _, _, policy, pstate, _ = load_run(a.run, adapt=loadable)
     act = policy_act(policy, pstate)
     steps = []
@@ -75,9 +71,9 @@ def main() -> int:
             obs, *_ = hand.env.step(np.asarray(act(obs["observation"][None], obs["desired_goal"][None]))[0])
             r = hand.read()
             if r["pressed"]:
-                f = split(hand)
+                f = split(hand, table, weld)
                 pull = max(-f["weld_z"], 1e-6)  # the weld pulling the hand down
-                steps.append({**r, **f, "puck_share": f["on_puck"] / pull})
+                steps.append({**r, **f, "on_puck": r["force"], "puck_share": r["force"] / pull})
     reach = np.array([s["reach"] for s in steps])
     rows = []
     for lo, hi in zip(BINS[:-1], BINS[1:], strict=True):
