@@ -16,11 +16,6 @@ ARM_REACH_RADIUS = 1.126
 ARM_REACH_CENTER = {"slide": (0.319, 0.744, 0.781)}
 ARM_REACH_CENTER_DEFAULT = (0.674, 0.744, 0.781)
 ARM_STRETCH_GAIN = 0.10  # m^0.5 per control step: the target's outward step is capped at this * sqrt(R - r)
-# The share of the weld's downward pull that FetchSlide-v4's pads pass to the puck they press, by the grip's distance
-# from the reach centre (experiments/reference/press_split.py on MuJoCo 3.11.0, the median over five HER policies):
-# the rest goes through the wrist into the straightening arm. Our gripper has no arm and passes it all.
-PRESS_REACH = (0.95, 0.9625, 0.9875, 1.0125, 1.0375, 1.0625, 1.0875, 1.1125)
-PRESS_SHARE = (1.0, 0.96, 0.84, 0.61, 0.44, 0.38, 0.19, 0.10)
 WORKSPACES = ("arm", "box")
 TARGET_STEP = 0.05  # metres of gripper target motion per unit action per control step
 
@@ -41,20 +36,13 @@ def within_reach(grip, target, center, radius=ARM_REACH_RADIUS, stretch_gain=ARM
     return center + off * xp.minimum(1.0, radius / xp.maximum(dist, 1e-9))
 
 
-def gripper_target(q, action_xyz, home, lo, hi, reach_center=None, stretch_gain=ARM_STRETCH_GAIN, xp=np, press=0.0):
+def gripper_target(q, action_xyz, home, lo, hi, reach_center=None, stretch_gain=ARM_STRETCH_GAIN, xp=np):
     """The xyz drive's next target in the gripper joints' coordinates (grip site = ``home`` + ``q``), as
     each control step sets it: ``TARGET_STEP * action_xyz`` from where the gripper is, clipped to the
     world box [``lo``, ``hi``], then kept within the reference arm's reach around ``reach_center``
-    (``within_reach``) unless that is None; with ``press`` > 0 its step down shrinks by ``press`` x the
-    share of the pull the reference arm takes there (``PRESS_SHARE``). The one rule of the tasks and of the C
-    replicas."""
+    (``within_reach``) unless that is None. The one rule of the tasks and of the C replicas."""
     home = xp.asarray(home)
     target = xp.clip(q + TARGET_STEP * action_xyz, xp.asarray(lo) - home, xp.asarray(hi) - home)
     if reach_center is not None:
         target = within_reach(q + home, target + home, reach_center, stretch_gain=stretch_gain, xp=xp) - home
-    if press and reach_center is not None:
-        r = xp.sqrt(xp.sum((q + home - xp.asarray(reach_center)) ** 2, axis=-1))
-        taken = press * (1.0 - xp.interp(r, xp.asarray(PRESS_REACH), xp.asarray(PRESS_SHARE)))
-        down = xp.minimum(target[..., 2] - q[..., 2], 0.0)
-        target = xp.concatenate([target[..., :2], (target[..., 2] - taken * down)[..., None]], axis=-1)
     return target

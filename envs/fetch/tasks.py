@@ -100,8 +100,6 @@ class _FetchTask(GoalEnv):
     gripper_mass: float = experimental(0.0, recorded_when_set=True)
     # Slide's pads pitched back as the reference arm stretches, by this fraction of its hand's tilt (hand_pitch.py)
     hand_pitch: float = experimental(0.0, recorded_when_set=True, unrecorded=0.0)
-    # Slide: this fraction of the share of the pull down the reference's straightening arm takes (control.py)
-    press_share: float = experimental(0.0, recorded_when_set=True, unrecorded=0.0)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -144,8 +142,6 @@ class _FetchTask(GoalEnv):
         check(0 <= self.gripper_mass <= 100, f"{n}.gripper_mass", self.gripper_mass, "in [0, 100] kg (0: the task's)")
         ok = self.hand_pitch == 0 or (n == "slide" and self.finger == "pads" and 0 < self.hand_pitch <= 2)
         check(ok, f"{n}.hand_pitch", self.hand_pitch, "0 off Slide's pads (finger=box: add hand_pitch=0), else (0, 2]")
-        ok = self.press_share == 0 or (n == "slide" and self.workspace == "arm" and 0 < self.press_share <= 1)
-        check(ok, f"{n}.press_share", self.press_share, "in (0, 1] on Slide in the arm's workspace, else 0")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -266,8 +262,9 @@ class _FetchTask(GoalEnv):
         g = lay.grip_q
         reach = lay.reach_center if self.workspace == "arm" else None
         lo = (*lay.workspace_lo[:2], lay.workspace_lo[2] + self.floor_clearance)
-        target = control.gripper_target(phys.qpos[g : g + 3], action[:3], lay.grip_home, lo,
-                                       lay.workspace_hi, reach, xp=jnp, press=self.press_share)  # fmt: skip
+        target = control.gripper_target(
+            phys.qpos[g : g + 3], action[:3], lay.grip_home, lo, lay.workspace_hi, reach, xp=jnp
+        )
         ctrl = phys.ctrl.at[0:3].set(target)
         if lay.finger_q is not None:
             f = lay.finger_q

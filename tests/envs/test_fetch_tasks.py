@@ -169,20 +169,6 @@ def test_slide_gripper_target_slows_near_the_arm_reach_and_stops_on_it():
     np.testing.assert_allclose(free, (1.43, 0.75, 0.394), atol=1e-6)  # box floor: the pads pressed on the table
 
 
-def test_press_share_weakens_a_step_down_only_as_the_arm_stretches():
-    plain, pressed = _env("slide"), envs.make("slide", press_share=1.0)
-    far = (1.30, 0.75, 0.45)  # 1.035 m from the reach centre, where the reference's puck takes under half the pull
-    down = [_target_after(e, far, (0.0, 0.0, -1.0, 0.0))[2] - far[2] for e in (plain, pressed)]
-    assert down[0] == pytest.approx(-0.05, abs=1e-6) and 0.4 < down[1] / down[0] < 0.5
-    up = [_target_after(e, far, (0.3, 0.0, 1.0, 0.0)) for e in (plain, pressed)]
-    np.testing.assert_allclose(up[0], up[1], atol=1e-7)  # the arm takes no share of a lift
-    near = (1.10, 0.75, 0.45)  # 0.85 m: all of the pull reaches the puck
-    np.testing.assert_allclose(*[_target_after(e, near, (0.0, 0.0, -1.0, 0.0)) for e in (plain, pressed)], atol=1e-7)
-    for kind, options in (("push", {}), ("slide", {"workspace": "box"})):
-        with pytest.raises(InvalidConfig, match="press_share"):
-            envs.make(kind, press_share=1.0, **options)
-
-
 def test_arm_reach_barely_touches_push_pick_and_reach_goal_regions():
     # their robot stands 0.355 m nearer the table than Slide's: every goal, and the pushing gripper 6 cm
     # behind it, lies over 20 cm inside the reach, where a full 5 cm step outward loses under 10 %

@@ -1,0 +1,124 @@
+"""How fast the gripper moves in free space as the arm stretches, in our Slide and in FetchSlide-v4 from the same
+start: the reference's 7-joint arm slows its grip near the reach's edge in every direction, ours (a weld on a free
+gripper, the outward step capped by ``envs.fetch.control.within_reach``) only outward.
+
+    python experiments/reference/stretch_speed.py [--env-options K=V,...] --out FILE.json
+
+Each drive lifts the grip 5 cm clear of the table (the puck is put 0.3 m behind and aside, out of the way), drives it
+at full action along +x for ``k`` steps (k in ``OUT_STEPS``: how far out it starts), waits ``SETTLE`` steps, then
+drives it at full action in one direction (``DIRECTIONS``: out, sideways, in) for ``DRIVE`` steps. Per step of the
+last leg: the grip's advance along the direction (m) and its distance from the reach centre at the step's start.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", ".."))
+
+from envs.fetch.control import ARM_REACH_CENTER  # noqa: E402
+from splid_jax.common.values import parse_overrides  # noqa: E402
+from splid_jax.reference.extra import import_reference, make_reference  # noqa: E402
+from splid_jax.reference.mapping import reference_shift, reference_start  # noqa: E402
+
+CENTER = np.asarray(ARM_REACH_CENTER["slide"])
+OUT_STEPS = (0, 3, 6, 9, 12, 15)
+DIRECTIONS = {"out": (1.0, 0.0), "side+": (0.0, 1.0), "side-": (0.0, -1.0), "in": (-1.0, 0.0)}
+SETTLE, DRIVE = 8, 10
+PUCK_AWAY = (-0.3, -0.3)  # the puck's x-y from the grip's home
+BINS = (0.75, 0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.15)
+
+
+def actions(k: int, direction: tuple[float, float]) -> list[tuple[float, ...]]:
+    return [(0, 0, 1, 0)] + [(1, 0, 0, 0)] * k + [(0, 0, 0, 0)] * SETTLE + [(*direction, 0, 0)] * DRIVE
+
+
+def ours(env, plan: list) -> np.ndarray:
+    """The grip's xyz per step in our task ``env``, [T + 1, 3]."""
+    import jax
+    import jax.numpy as jnp
+
+    lay, o = env.layout, env.layout.object_q
+    s = env.reset(jax.random.PRNGKey(0))
+    xy = jnp.asarray(lay.grip_home[:2]) + jnp.asarray(PUCK_AWAY)
+    phys = s.physics.replace(qpos=s.physics.qpos.at[o : o + 2].set(xy))
+    s = env._state(phys, s.desired_goal, jnp.int32(0), jnp.bool_(False))
+    step = jax.jit(env.step)
+    out = [np.asarray(s.obs[:3])]
+    for a in plan:
+        s = step(s, jnp.asarray(a, jnp.float32))
+        out.append(np.asarray(s.obs[:3]))
+    return np.array(out, np.float64)
+
+
+def reference(task_env, plan: list) -> np.ndarray:
+    env = make_reference("slide")
+    env.reset(seed=0)
+    xy = np.asarray(task_env.layout.grip_home[:2]) + np.asarray(PUCK_AWAY)
+    obs = reference_start(env, xy + reference_shift(task_env, env)[:2], np.asarray(env.unwrapped.goal))
+    out = [obs["observation"][:3]]
+    for a in plan:
+        obs, *_ = env.step(np.asarray(a, np.float64))
+        out.append(obs["observation"][:3])
+    env.close()
+    return np.array(out, np.float64)
+
+
+def drive_steps(grip: np.ndarray, k: int, direction) -> tuple[np.ndarray, np.ndarray]:
+    """The last leg's steps: the grip's reach at each step's start and its advance along ``direction``."""
+    start = 1 + k + SETTLE
+    g = grip[start:]
+    u = np.asarray(direction, float)
+    return np.linalg.norm(g[:-1] - CENTER, axis=1), np.diff(g[:, :2], axis=0) @ u
+
+
+def summary(drives: list[dict]) -> list[dict]:
+    """Per direction class and reach bin, the median advance per step from the leg's third step on (at speed)."""
+    rows = []
+    for cls in ("out", "side", "in"):
+        for lo, hi in zip(BINS[:-1], BINS[1:], strict=True):
+            row = {"direction": cls, "reach": [lo, hi]}
+            for sim in ("ours", "fetch"):
+                v = [a for d in drives if d["direction"].startswith(cls)
+                     for r, a in list(zip(d[sim]["reach"], d[sim]["advance"], strict=True))[2:] if lo <= r < hi]  # fmt: skip
+                row[sim] = [len(v), round(float(np.median(v)), 4) if v else None]
+            if row["ours"][0] >= 3 and row["fetch"][0] >= 3:
+                row["ratio"] = round(row["fetch"][1] / row["ours"][1], 3)
+                rows.append(row)
+    return rows
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--env-options", default="", help="our task's fields")
+    p.add_argument("--out", required=True)
+    args = p.parse_args(argv)
+    import envs
+
+    import_reference()
+    env = envs.make("slide", **parse_overrides(args.env_options))
+    drives = []
+    for k in OUT_STEPS:
+        for name, direction in DIRECTIONS.items():
+            plan = actions(k, direction)
+            row = {"out_steps": k, "direction": name}
+            for sim, grip in (("ours", ours(env, plan)), ("fetch", reference(env, plan))):
+                reach, advance = drive_steps(grip, k, direction)
+                row[sim] = {"reach": reach.round(4).tolist(), "advance": advance.round(5).tolist()}
+            drives.append(row)
+            print(k, name, "ours", row["ours"]["advance"][2:6], "fetch", row["fetch"]["advance"][2:6], flush=True)
+    result = {"env_options": args.env_options, "summary": summary(drives), "drives": drives}
+    for r in result["summary"]:
+        print(r)
+    with open(args.out, "w") as f:
+        json.dump(result, f, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
