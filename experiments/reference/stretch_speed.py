@@ -84,8 +84,9 @@ def summary(drives: list[dict]) -> list[dict]:
         for lo, hi in zip(BINS[:-1], BINS[1:], strict=True):
             row = {"direction": cls, "reach": [lo, hi]}
             for sim in ("ours", "fetch"):
-                v = [a for d in drives if d["direction"].startswith(cls)
-                     for r, a in list(zip(d[sim]["reach"], d[sim]["advance"], strict=True))[2:] if lo <= r < hi]  # fmt: skip
+                pairs = [list(zip(d[sim]["reach"], d[sim]["advance"], strict=True))[2:]
+                         for d in drives if d["direction"].startswith(cls)]  # fmt: skip
+                v = [a for leg in pairs for r, a in leg if lo <= r < hi]
                 row[sim] = [len(v), round(float(np.median(v)), 4) if v else None]
             if row["ours"][0] >= 3 and row["fetch"][0] >= 3:
                 row["ratio"] = round(row["fetch"][1] / row["ours"][1], 3)
