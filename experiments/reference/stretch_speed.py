@@ -3,11 +3,14 @@ start: the reference's 7-joint arm slows its grip near the reach's edge in every
 gripper, the outward step capped by ``envs.fetch.control.within_reach``) only outward.
 
     python experiments/reference/stretch_speed.py [--env-options K=V,...] --out FILE.json
+    python experiments/reference/stretch_speed.py --fit FILE.json --gains 0.06,0.08,0.1 [--env-options K=V,...]
 
 Each drive lifts the grip 5 cm clear of the table (the puck is put 0.3 m behind and aside, out of the way), drives it
 at full action along +x for ``k`` steps (k in ``OUT_STEPS``: how far out it starts), waits ``SETTLE`` steps, then
 drives it at full action in one direction (``DIRECTIONS``: out, sideways, in) for ``DRIVE`` steps. Per step of the
 last leg: the grip's advance along the direction (m) and its distance from the reach centre at the step's start.
+``--fit`` replays the recorded drives on our task's model in MuJoCo C (free space: no contact but the weld's) for each
+stretch gain (``control.gripper_target``'s) and prints how far each leg's advances lie from the reference's.
 """
 
 from __future__ import annotations
@@ -69,6 +72,46 @@ def reference(task_env, plan: list) -> np.ndarray:
     return np.array(out, np.float64)
 
 
+def ours_c(env, plan: list, gain: float) -> np.ndarray:
+    """``ours`` in MuJoCo C on the task's own model with stretch gain ``gain``, the puck put away the same way."""
+    import mujoco
+
+    from envs.fetch import control
+
+    lay, m = env.layout, env.mj_model
+    d = mujoco.MjData(m)
+    home, g, o = np.asarray(lay.grip_home), lay.grip_q, lay.object_q
+    d.qpos[o : o + 2] = home[:2] + np.asarray(PUCK_AWAY)
+    mujoco.mj_forward(m, d)
+    lo = (*lay.workspace_lo[:2], lay.workspace_lo[2] + env.floor_clearance)
+    out = [home + d.qpos[g : g + 3]]
+    for a in plan:
+        t = control.gripper_target(d.qpos[g : g + 3], np.asarray(a[:3]), home, lo, lay.workspace_hi,
+                                   lay.reach_center, gain)  # fmt: skip
+        d.ctrl[0:3] = t
+        if m.nmocap:
+            d.mocap_pos[0] = home + t
+        for _ in range(env.substeps):
+            mujoco.mj_step(m, d)
+        out.append(home + d.qpos[g : g + 3])
+    return np.array(out, np.float64)
+
+
+def fit(env, recorded: dict, gains) -> list[dict]:
+    """Per stretch gain, the RMS (mm) of ours' advances per step against the reference's, out legs and sideways."""
+    rows = []
+    for gain in gains:
+        err = {"out": [], "side": [], "in": []}
+        for dr in recorded["drives"]:
+            k, direction = dr["out_steps"], DIRECTIONS[dr["direction"]]
+            _, adv = drive_steps(ours_c(env, actions(k, direction), gain), k, direction)
+            err[dr["direction"].rstrip("+-")].extend(adv - np.asarray(dr["fetch"]["advance"]))
+        rms = {c: round(1000 * float(np.sqrt(np.mean(np.square(e)))), 2) for c, e in err.items()}
+        rows.append({"gain": gain, **rms})
+        print(rows[-1], flush=True)
+    return rows
+
+
 def drive_steps(grip: np.ndarray, k: int, direction) -> tuple[np.ndarray, np.ndarray]:
     """The last leg's steps: the grip's reach at each step's start and its advance along ``direction``."""
     start = 1 + k + SETTLE
@@ -97,12 +140,20 @@ def summary(drives: list[dict]) -> list[dict]:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--env-options", default="", help="our task's fields")
-    p.add_argument("--out", required=True)
+    p.add_argument("--out", default=None)
+    p.add_argument("--fit", default=None, help="a recorded run of this probe: fit our stretch gain to its drives")
+    p.add_argument("--gains", default="0.1", help="stretch gains to try with --fit, comma-separated")
     args = p.parse_args(argv)
     import envs
 
-    import_reference()
     env = envs.make("slide", **parse_overrides(args.env_options))
+    if args.fit:
+        with open(args.fit) as f:
+            fit(env, json.load(f), [float(g) for g in args.gains.split(",")])
+        return 0
+    if not args.out:
+        p.error("--out is required without --fit")
+    import_reference()
     drives = []
     for k in OUT_STEPS:
         for name, direction in DIRECTIONS.items():
