@@ -169,6 +169,19 @@ def test_slide_gripper_target_slows_near_the_arm_reach_and_stops_on_it():
     np.testing.assert_allclose(free, (1.43, 0.75, 0.394), atol=1e-6)  # box floor: the pads pressed on the table
 
 
+def test_stretch_gain_scales_only_the_capped_outward_step():
+    plain, slow = _env("slide"), envs.make("slide", stretch_gain=0.07)
+    center = np.asarray(control.ARM_REACH_CENTER["slide"])
+    far = np.array([1.30, 0.75, 0.45])  # 1.0 m from the reach centre: a full step outward is capped
+    n = (far - center) / np.linalg.norm(far - center)
+    out = [(_target_after(e, far, (1.0, 0.0, 0.0, 0.0)) - far) @ n for e in (plain, slow)]
+    assert out[0] < 0.05 and out[1] / out[0] == pytest.approx(0.7, rel=1e-3)
+    back = [_target_after(e, far, (-1.0, 0.0, 0.0, 0.0)) for e in (plain, slow)]
+    np.testing.assert_allclose(*back, atol=1e-7)  # a step inward is not capped
+    with pytest.raises(InvalidConfig, match="stretch_gain"):
+        envs.make("slide", stretch_gain=2.0)
+
+
 def test_arm_reach_barely_touches_push_pick_and_reach_goal_regions():
     # their robot stands 0.355 m nearer the table than Slide's: every goal, and the pushing gripper 6 cm
     # behind it, lies over 20 cm inside the reach, where a full 5 cm step outward loses under 10 %
