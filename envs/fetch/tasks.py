@@ -100,8 +100,8 @@ class _FetchTask(GoalEnv):
     gripper_mass: float = experimental(0.0, recorded_when_set=True)
     # Slide's pads pitched back as the reference arm stretches, by this fraction of its hand's tilt (hand_pitch.py)
     hand_pitch: float = experimental(0.0, recorded_when_set=True, unrecorded=0.0)
-    # The arm's outward slow-down near its reach (control.within_reach; 0: control.ARM_STRETCH_GAIN)
-    stretch_gain: float = experimental(0.0, recorded_when_set=True)
+    # Held near its reach, the arm folds back toward its centre: control.DRIFT x this (1.75 the reference's drift)
+    arm_drift: float = experimental(0.0, recorded_when_set=True)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -144,7 +144,8 @@ class _FetchTask(GoalEnv):
         check(0 <= self.gripper_mass <= 100, f"{n}.gripper_mass", self.gripper_mass, "in [0, 100] kg (0: the task's)")
         ok = self.hand_pitch == 0 or (n == "slide" and self.finger == "pads" and 0 < self.hand_pitch <= 2)
         check(ok, f"{n}.hand_pitch", self.hand_pitch, "0 off Slide's pads (finger=box: add hand_pitch=0), else (0, 2]")
-        check(0 <= self.stretch_gain <= 1, f"{n}.stretch_gain", self.stretch_gain, "in [0, 1] (0: control's)")
+        ok = 0 <= self.arm_drift <= 5 and (self.arm_drift == 0 or self.workspace == "arm")
+        check(ok, f"{n}.arm_drift", self.arm_drift, "in [0, 5] in the arm's workspace, else 0")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -261,10 +262,11 @@ class _FetchTask(GoalEnv):
 
     # ---- step --------------------------------------------------------------------------------
     def _control(self, phys: Physics, action: jax.Array) -> jax.Array:
-        lay, g, gain = self.layout, self.layout.grip_q, self.stretch_gain or control.ARM_STRETCH_GAIN
+        lay, g, gain = self.layout, self.layout.grip_q, control.ARM_STRETCH_GAIN
         reach = lay.reach_center if self.workspace == "arm" else None
         lo, hi = (*lay.workspace_lo[:2], lay.workspace_lo[2] + self.floor_clearance), lay.workspace_hi
-        target = control.gripper_target(phys.qpos[g : g + 3], action[:3], lay.grip_home, lo, hi, reach, gain, jnp)
+        q = phys.qpos[g : g + 3]
+        target = control.gripper_target(q, action[:3], lay.grip_home, lo, hi, reach, gain, jnp, self.arm_drift)
         ctrl = phys.ctrl.at[0:3].set(target)
         if lay.finger_q is not None:
             f = lay.finger_q

@@ -169,17 +169,20 @@ def test_slide_gripper_target_slows_near_the_arm_reach_and_stops_on_it():
     np.testing.assert_allclose(free, (1.43, 0.75, 0.394), atol=1e-6)  # box floor: the pads pressed on the table
 
 
-def test_stretch_gain_scales_only_the_capped_outward_step():
-    plain, slow = _env("slide"), envs.make("slide", stretch_gain=0.07)
+def test_arm_drift_pulls_a_held_grip_back_along_the_floor_only_near_the_reach():
+    plain, drifting = _env("slide"), envs.make("slide", arm_drift=2.0)
     center = np.asarray(control.ARM_REACH_CENTER["slide"])
-    far = np.array([1.30, 0.75, 0.45])  # 1.0 m from the reach centre: a full step outward is capped
-    n = (far - center) / np.linalg.norm(far - center)
-    out = [(_target_after(e, far, (1.0, 0.0, 0.0, 0.0)) - far) @ n for e in (plain, slow)]
-    assert out[0] < 0.05 and out[1] / out[0] == pytest.approx(0.7, rel=1e-3)
-    back = [_target_after(e, far, (-1.0, 0.0, 0.0, 0.0)) for e in (plain, slow)]
-    np.testing.assert_allclose(*back, atol=1e-7)  # a step inward is not capped
-    with pytest.raises(InvalidConfig, match="stretch_gain"):
-        envs.make("slide", stretch_gain=2.0)
+    far = np.array([1.30, 0.90, 0.45])  # 1.04 m from the reach centre
+    held = [_target_after(e, far, (0.0, 0.0, 0.0, 0.0)) for e in (plain, drifting)]
+    np.testing.assert_allclose(held[0], far, atol=1e-6)
+    back = 2.0 * np.interp(np.linalg.norm(far - center), control.DRIFT_REACH, control.DRIFT)
+    flat = np.append((far - center)[:2], 0.0)
+    np.testing.assert_allclose(held[1], far - back * flat / np.linalg.norm(flat), atol=1e-6)
+    assert back > 0.015
+    near = (1.10, 0.75, 0.45)  # 0.85 m: held where it is
+    np.testing.assert_allclose(*[_target_after(e, near, (0.0, 0.0, 0.0, 0.0)) for e in (plain, drifting)], atol=1e-7)
+    with pytest.raises(InvalidConfig, match="arm_drift"):
+        envs.make("slide", arm_drift=1.0, workspace="box")
 
 
 def test_arm_reach_barely_touches_push_pick_and_reach_goal_regions():
