@@ -100,7 +100,7 @@ class _FetchTask(GoalEnv):
     gripper_mass: float = experimental(0.0, recorded_when_set=True)
     # Slide's pads pitched back as the reference arm stretches, by this fraction of its hand's tilt (hand_pitch.py)
     hand_pitch: float = experimental(0.0, recorded_when_set=True, unrecorded=0.0)
-    # Held near its reach, the arm folds back toward its centre: control.DRIFT x this (1.75 the reference's drift)
+    # Held near its reach, the arm folds back toward its centre: control.DRIFT x this (1.5 the reference's drift)
     arm_drift: float = experimental(0.0, recorded_when_set=True)
 
     kind = ""  # models.KINDS entry

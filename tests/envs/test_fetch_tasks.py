@@ -179,6 +179,8 @@ def test_arm_drift_pulls_a_held_grip_back_along_the_floor_only_near_the_reach():
     flat = np.append((far - center)[:2], 0.0)
     np.testing.assert_allclose(held[1], far - back * flat / np.linalg.norm(flat), atol=1e-6)
     assert back > 0.015
+    out = [_target_after(e, far, (*(flat[:2] / np.linalg.norm(flat)), 0.0, 0.0)) for e in (plain, drifting)]
+    np.testing.assert_allclose(*out, atol=1e-7)  # a drive outward: the stretch cap alone slows it
     near = (1.10, 0.75, 0.45)  # 0.85 m: held where it is
     np.testing.assert_allclose(*[_target_after(e, near, (0.0, 0.0, 0.0, 0.0)) for e in (plain, drifting)], atol=1e-7)
     with pytest.raises(InvalidConfig, match="arm_drift"):
