@@ -23,9 +23,10 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", ".."))
 
+from slide_on_puck import place_puck  # noqa: E402
+
 from envs.fetch.control import ARM_REACH_CENTER  # noqa: E402
 from splid_jax.reference.extra import import_reference, make_reference  # noqa: E402
-from splid_jax.reference.mapping import reference_shift, reference_start  # noqa: E402
 
 CENTER = np.asarray(ARM_REACH_CENTER["slide"])
 OUT_STEPS = (0, 4, 8, 10, 12, 14)
@@ -47,10 +48,7 @@ class Arm:
         self.grip = mujoco.mj_name2id(self.m, mujoco.mjtObj.mjOBJ_SITE, "robot0:grip")
 
     def start(self, k: int):
-        self.env.reset(seed=0)
-        xy = np.asarray(self.task_env.layout.grip_home[:2]) + np.asarray(PUCK_AWAY)
-        goal = np.asarray(self.env.unwrapped.goal)
-        reference_start(self.env, xy + reference_shift(self.task_env, self.env)[:2], goal)
+        place_puck(self.task_env, self.env, PUCK_AWAY)
         start = self.d.xmat[self.hand].reshape(3, 3)
         self.axis = int(np.argmax(np.abs(start[2])))
         self.sign = np.sign(start[2, self.axis])

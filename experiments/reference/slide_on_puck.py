@@ -29,33 +29,40 @@ ACTIONS = (
 )
 
 
-def ours(env, offset: float) -> np.ndarray:
-    """Observation slots 0:6 (grip xyz, puck xyz) per step in our task ``env``, [T + 1, 6]."""
+def ours(env, puck_from_home, plan) -> np.ndarray:
+    """Observation slots 0:6 (grip xyz, puck xyz) per step of ``plan`` (actions) in our task ``env``, the puck put
+    at ``puck_from_home`` (x-y) from the grip's home, [T + 1, 6]."""
     import jax
     import jax.numpy as jnp
 
     lay = env.layout
     s = env.reset(jax.random.PRNGKey(0))
     o = lay.object_q
-    xy = jnp.asarray(lay.grip_home[:2]) + jnp.array([0.04 + offset, 0.0])
+    xy = jnp.asarray(lay.grip_home[:2]) + jnp.asarray(puck_from_home)
     phys = s.physics.replace(qpos=s.physics.qpos.at[o : o + 2].set(xy))
     s = env._state(phys, s.desired_goal, jnp.int32(0), jnp.bool_(False))
     step = jax.jit(env.step)
     out = [np.asarray(s.obs[:6])]
-    for a in ACTIONS:
+    for a in plan:
         s = step(s, jnp.asarray(a, jnp.float32))
         out.append(np.asarray(s.obs[:6]))
     return np.array(out, np.float64)
 
 
-def reference(task_env, offset: float) -> np.ndarray:
-    """The same in FetchSlide-v4, the puck put at the same place relative to the grip home."""
-    env = make_reference("slide")
+def place_puck(task_env, env, puck_from_home) -> dict:
+    """Reset FetchSlide-v4 ``env`` with its puck where our ``task_env`` would have it (``puck_from_home`` from the
+    grip's home); its observation."""
     env.reset(seed=0)
-    xy = np.asarray(task_env.layout.grip_home[:2]) + np.array([0.04 + offset, 0.0])
-    obs = reference_start(env, xy + reference_shift(task_env, env)[:2], np.asarray(env.unwrapped.goal))
+    xy = np.asarray(task_env.layout.grip_home[:2]) + np.asarray(puck_from_home)
+    return reference_start(env, xy + reference_shift(task_env, env)[:2], np.asarray(env.unwrapped.goal))
+
+
+def reference(task_env, puck_from_home, plan) -> np.ndarray:
+    """``ours`` in FetchSlide-v4."""
+    env = make_reference("slide")
+    obs = place_puck(task_env, env, puck_from_home)
     out = [obs["observation"][:6]]
-    for a in ACTIONS:
+    for a in plan:
         obs, *_ = env.step(np.asarray(a, np.float64))
         out.append(obs["observation"][:6])
     env.close()
@@ -72,7 +79,8 @@ def main(argv=None) -> int:
 
     import_reference()
     env = envs.make("slide", **parse_overrides(args.env_options))
-    sims = {"ours": ours(env, args.offset), "fetch": reference(env, args.offset)}
+    puck = (0.04 + args.offset, 0.0)
+    sims = {"ours": ours(env, puck, ACTIONS), "fetch": reference(env, puck, ACTIONS)}
     result = {"offset": args.offset, "env_options": args.env_options, "actions": ACTIONS}
     for name, x in sims.items():
         result[name] = {

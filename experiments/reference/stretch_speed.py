@@ -26,10 +26,11 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", ".."))
 
+from slide_on_puck import ours, reference  # noqa: E402
+
 from envs.fetch.control import ARM_REACH_CENTER  # noqa: E402
 from splid_jax.common.values import parse_overrides  # noqa: E402
-from splid_jax.reference.extra import import_reference, make_reference  # noqa: E402
-from splid_jax.reference.mapping import reference_shift, reference_start  # noqa: E402
+from splid_jax.reference.extra import import_reference  # noqa: E402
 
 CENTER = np.asarray(ARM_REACH_CENTER["slide"])
 OUT_STEPS = (0, 3, 6, 9, 12, 15, 20)
@@ -43,39 +44,9 @@ def actions(k: int, direction: tuple[float, float]) -> list[tuple[float, ...]]:
     return [(0, 0, 1, 0)] + [(1, 0, 0, 0)] * k + [(0, 0, 0, 0)] * SETTLE + [(*direction, 0, 0)] * DRIVE
 
 
-def ours(env, plan: list) -> np.ndarray:
-    """The grip's xyz per step in our task ``env``, [T + 1, 3]."""
-    import jax
-    import jax.numpy as jnp
-
-    lay, o = env.layout, env.layout.object_q
-    s = env.reset(jax.random.PRNGKey(0))
-    xy = jnp.asarray(lay.grip_home[:2]) + jnp.asarray(PUCK_AWAY)
-    phys = s.physics.replace(qpos=s.physics.qpos.at[o : o + 2].set(xy))
-    s = env._state(phys, s.desired_goal, jnp.int32(0), jnp.bool_(False))
-    step = jax.jit(env.step)
-    out = [np.asarray(s.obs[:3])]
-    for a in plan:
-        s = step(s, jnp.asarray(a, jnp.float32))
-        out.append(np.asarray(s.obs[:3]))
-    return np.array(out, np.float64)
-
-
-def reference(task_env, plan: list) -> np.ndarray:
-    env = make_reference("slide")
-    env.reset(seed=0)
-    xy = np.asarray(task_env.layout.grip_home[:2]) + np.asarray(PUCK_AWAY)
-    obs = reference_start(env, xy + reference_shift(task_env, env)[:2], np.asarray(env.unwrapped.goal))
-    out = [obs["observation"][:3]]
-    for a in plan:
-        obs, *_ = env.step(np.asarray(a, np.float64))
-        out.append(obs["observation"][:3])
-    env.close()
-    return np.array(out, np.float64)
-
-
 def ours_c(env, plan: list, gain: float, drift: float = 0.0) -> np.ndarray:
-    """``ours`` in MuJoCo C on the task's own model with stretch gain ``gain``, the puck put away the same way."""
+    """The grip's xyz per step of ``plan`` on our task's own model in MuJoCo C with stretch gain ``gain``, the puck
+    put away as ``drives`` puts it, [T + 1, 3]."""
     import mujoco
 
     from envs.fetch import control
@@ -169,8 +140,8 @@ def main(argv=None) -> int:
         for name, direction in DIRECTIONS.items():
             plan = actions(k, direction)
             row = {"out_steps": k, "direction": name}
-            for sim, grip in (("ours", ours(env, plan)), ("fetch", reference(env, plan))):
-                reach, advance = drive_steps(grip, k, direction)
+            for sim, obs in (("ours", ours(env, PUCK_AWAY, plan)), ("fetch", reference(env, PUCK_AWAY, plan))):
+                reach, advance = drive_steps(obs[:, :3], k, direction)
                 row[sim] = {"reach": reach.round(4).tolist(), "advance": advance.round(5).tolist()}
             drives.append(row)
             print(k, name, "ours", row["ours"]["advance"][2:6], "fetch", row["fetch"]["advance"][2:6], flush=True)
