@@ -262,11 +262,11 @@ class _FetchTask(GoalEnv):
 
     # ---- step --------------------------------------------------------------------------------
     def _control(self, phys: Physics, action: jax.Array) -> jax.Array:
-        lay, g, gain = self.layout, self.layout.grip_q, control.ARM_STRETCH_GAIN
+        lay, g = self.layout, self.layout.grip_q
         reach = lay.reach_center if self.workspace == "arm" else None
         lo, hi = (*lay.workspace_lo[:2], lay.workspace_lo[2] + self.floor_clearance), lay.workspace_hi
         q = phys.qpos[g : g + 3]
-        target = control.gripper_target(q, action[:3], lay.grip_home, lo, hi, reach, gain, jnp, self.arm_drift)
+        target = control.gripper_target(q, action[:3], lay.grip_home, lo, hi, reach, xp=jnp, drift=self.arm_drift)
         ctrl = phys.ctrl.at[0:3].set(target)
         if lay.finger_q is not None:
             f = lay.finger_q
