@@ -101,7 +101,7 @@ class _FetchTask(GoalEnv):
     # Slide's pads pitched back as the reference arm stretches, by this fraction of its hand's tilt (hand_pitch.py)
     hand_pitch: float = experimental(0.0, recorded_when_set=True, unrecorded=0.0)
     # Held near its reach, the arm folds back toward its centre: control.DRIFT x this (1.5 the reference's drift)
-    arm_drift: float = experimental(0.0, recorded_when_set=True)
+    arm_drift: float = experimental(0.0, recorded_when_set=True, unrecorded=0.0)
 
     kind = ""  # models.KINDS entry
     has_object = True
@@ -145,7 +145,7 @@ class _FetchTask(GoalEnv):
         ok = self.hand_pitch == 0 or (n == "slide" and self.finger == "pads" and 0 < self.hand_pitch <= 2)
         check(ok, f"{n}.hand_pitch", self.hand_pitch, "0 off Slide's pads (finger=box: add hand_pitch=0), else (0, 2]")
         ok = 0 <= self.arm_drift <= 5 and (self.arm_drift == 0 or self.workspace == "arm")
-        check(ok, f"{n}.arm_drift", self.arm_drift, "in [0, 5] in the arm's workspace, else 0")
+        check(ok, f"{n}.arm_drift", self.arm_drift, "in [0, 5] in the arm's workspace (workspace=box: add arm_drift=0)")
         check_integer(f"{n}.max_episode_steps", self.max_episode_steps, 1)
         check(0 < self.timestep <= 0.01, f"{n}.timestep", self.timestep, "in (0, 0.01] seconds")
         check_integer(f"{n}.substeps", self.substeps, 1, 100)
@@ -350,15 +350,16 @@ class Slide(_FetchTask):
     """Strike a low-friction puck (a cylinder on a plane table top, see models.py) to a goal 0.4 m ahead,
     out of reach. The fingers are the reference's: box pads (``finger="pads"``, a box-cylinder contact MJX
     lacks, envs/fetch/slide_fingers.py) that touch the table, pitch back as its hand does at stretch
-    (``hand_pitch``), moved by its weld law with its arm's effective mass: round fingertips let a policy ride
-    the puck, which the reference does not allow, so their policies failed there (experiments/NOTES.md,
-    "Slide with the reference's pads", "The hand's pitch")."""
+    (``hand_pitch``), moved by its weld law with its arm's effective mass, the arm folding back when held at
+    stretch (``arm_drift``): round fingertips let a policy ride the puck, which the reference does not allow, so
+    their policies failed there (experiments/NOTES.md, "Slide with the reference's pads", "The hand's pitch")."""
 
     finger: str = "pads"
     finger_table: float = 1.0
     drive: str = "weld"
     gripper_mass: float = dataclasses.field(default=22.0, metadata={"recorded_when_set": True, "unrecorded": 0.0})
     hand_pitch: float = dataclasses.field(default=1.0, metadata={"recorded_when_set": True, "unrecorded": 0.0})
+    arm_drift: float = dataclasses.field(default=1.5, metadata={"recorded_when_set": True, "unrecorded": 0.0})
     obj_range: float = 0.1
     target_range: float = 0.3
     iterations: int = 10  # 4 let a resting low-friction puck creep in float32 (up to 10 cm in 50 steps)

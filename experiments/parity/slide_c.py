@@ -50,10 +50,12 @@ def run(
     ep_starts=None,
     on_substep=None,
     workspace="arm",
+    drift=0.0,
 ):
     """Run the slide controller on ``xml``; returns a dict of per-episode arrays. ``on_substep(i, m, d)``,
     if given, is called after every MuJoCo step of episode ``i``. ``workspace`` is the task field's:
-    "arm" also keeps the gripper target within the reference arm's reach, "box" does not."""
+    "arm" also keeps the gripper target within the reference arm's reach, "box" does not. ``drift`` is the task field
+    ``arm_drift`` (Slide's default 1.5; the results recorded here ran without it)."""
     import jax
 
     from envs.fetch import control, models, scripted
@@ -104,7 +106,7 @@ def run(
         for i, d in enumerate(ds):
             if bad[i]:
                 continue
-            d.ctrl[0:3] = control.gripper_target(d.qpos[g : g + 3], act[i, :3], home, lo, hi, reach_center)
+            d.ctrl[0:3] = control.gripper_target(d.qpos[g : g + 3], act[i, :3], home, lo, hi, reach_center, drift=drift)
             if m.nmocap:  # drive="weld": the constraint pulls the gripper to the mocap target
                 d.mocap_pos[0] = home + d.ctrl[0:3]
             for _ in range(substeps):

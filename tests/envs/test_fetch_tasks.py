@@ -155,22 +155,23 @@ def _target_after(env, grip_world, action):
 
 def test_slide_gripper_target_slows_near_the_arm_reach_and_stops_on_it():
     center, radius = np.asarray(control.ARM_REACH_CENTER["slide"]), control.ARM_REACH_RADIUS
-    far = _target_after(_env("slide"), (1.38, 0.75, 0.42), (1.0, 0.0, -1.0, 0.0))
+    capped = envs.make("slide", arm_drift=0.0)  # the cap alone
+    far = _target_after(capped, (1.38, 0.75, 0.42), (1.0, 0.0, -1.0, 0.0))
     assert np.linalg.norm(far - center) <= radius + 1e-6
     assert far[0] < 1.39 < 1.38 + 0.05  # the reference's gripper stops at x 1.39 here
     grip = np.array([1.30, 0.75, 0.42])  # 8 cm inside the reach
-    near = _target_after(_env("slide"), grip, (1.0, 0.0, 0.0, 0.0))
+    near = _target_after(capped, grip, (1.0, 0.0, 0.0, 0.0))
     n = (grip - center) / np.linalg.norm(grip - center)
     cap = control.ARM_STRETCH_GAIN * np.sqrt(radius - np.linalg.norm(grip - center))
     np.testing.assert_allclose((near - grip) @ n, cap, rtol=1e-4)  # outward step capped, < the asked 5 cm
-    inside = _target_after(_env("slide"), (1.0, 0.75, 0.45), (1.0, 0.0, -0.4, 0.0))
+    inside = _target_after(capped, (1.0, 0.75, 0.45), (1.0, 0.0, -0.4, 0.0))
     np.testing.assert_allclose(inside, (1.05, 0.75, 0.43), atol=1e-6)  # well within reach: unchanged
-    free = _target_after(envs.make("slide", workspace="box"), (1.38, 0.75, 0.42), (1.0, 0.0, -1.0, 0.0))
+    free = _target_after(envs.make("slide", workspace="box", arm_drift=0.0), (1.38, 0.75, 0.42), (1.0, 0.0, -1.0, 0.0))
     np.testing.assert_allclose(free, (1.43, 0.75, 0.394), atol=1e-6)  # box floor: the pads pressed on the table
 
 
 def test_arm_drift_pulls_a_held_grip_back_along_the_floor_only_near_the_reach():
-    plain, drifting = _env("slide"), envs.make("slide", arm_drift=2.0)
+    plain, drifting = envs.make("slide", arm_drift=0.0), envs.make("slide", arm_drift=2.0)
     center = np.asarray(control.ARM_REACH_CENTER["slide"])
     far = np.array([1.30, 0.90, 0.45])  # 1.04 m from the reach centre
     held = [_target_after(e, far, (0.0, 0.0, 0.0, 0.0)) for e in (plain, drifting)]
