@@ -128,9 +128,10 @@ def main(argv=None) -> int:
     result = {"env_options": args.env_options, "reference_collider": "libccd" if args.libccd else "native",
               "offsets": {}}
     for offset in () if args.no_press else [float(x) for x in args.offsets.split(",")]:
-        row = {"ours": measures(probe.ours(env, offset))}
+        puck = (0.04 + offset, 0.0)
+        row = {"ours": measures(probe.ours(env, puck, probe.ACTIONS))}
         if not args.no_reference:
-            row["fetch"] = measures(probe.reference(env, offset))
+            row["fetch"] = measures(probe.reference(env, puck, probe.ACTIONS))
         result["offsets"][str(offset)] = row
         for name, m in row.items():
             print(f"offset {offset:.4f} {name:5s} " + " ".join(f"{k}={v}" for k, v in m.items()), flush=True)
