@@ -5,9 +5,9 @@ puck overshoots the goal, it leaves the pads within a few steps and faster, whil
     python experiments/reference/pad_push.py --side ours|reference [--env-options K=V,...] --out FILE.json
 
 Each push lowers the pads to the table beside the grip's home (``DOWN`` steps), then drives at ``speed`` x full action
-along +x (pressing lightly down) for ``PUSH`` steps and holds still for ``REST`` more; the puck starts ``AHEAD`` m
-ahead of the grip and ``dy`` aside. Per push: the puck's speed per step, the steps the grip stays within ``NEAR`` m
-of it, its peak speed and how far it went.
+along +x and ``press`` along z (``PRESSES``: lightly down, or level) for ``PUSH`` steps and holds still for ``REST``
+more; the puck starts ``AHEAD`` m ahead of the grip and ``dy`` aside. Per push (keyed "speed,dy,press"): the puck's
+speed per step, the steps the grip stays within ``NEAR`` m of it, its peak speed and how far it went.
 """
 
 from __future__ import annotations
@@ -28,11 +28,11 @@ from splid_jax.reference.extra import import_reference  # noqa: E402
 
 DOWN, PUSH, REST = 4, 8, 20
 AHEAD, NEAR, DT = 0.08, 0.045, 0.04
-SPEEDS, ASIDE = (0.6, 0.8, 1.0), (0.0, 0.01)
+SPEEDS, ASIDE, PRESSES = (0.6, 0.8, 1.0), (0.0, 0.01), (-0.3, 0.0)
 
 
-def plan(speed: float) -> list[tuple[float, ...]]:
-    return [(0, 0, -1, 0)] * DOWN + [(speed, 0, -0.3, 0)] * PUSH + [(0, 0, 0, 0)] * REST
+def plan(speed: float, press: float) -> list[tuple[float, ...]]:
+    return [(0, 0, -1, 0)] * DOWN + [(speed, 0, press, 0)] * PUSH + [(0, 0, 0, 0)] * REST
 
 
 def measures(x: np.ndarray) -> dict:
@@ -58,12 +58,13 @@ def main(argv=None) -> int:
         import_reference()
     play = ours if args.side == "ours" else reference
     result = {"side": args.side, "env_options": args.env_options, "pushes": {}}
-    for speed in SPEEDS:
-        for dy in ASIDE:
-            m = measures(play(env, (AHEAD, dy), plan(speed)))
-            result["pushes"][f"{speed},{dy}"] = m
-            print(f"speed {speed} aside {dy}: near {m['near_steps']} peak {m['peak_speed']} launch {m['launch_step']}"
-                  f" travel {m['travel']}", flush=True)  # fmt: skip
+    for press in PRESSES:
+        for speed in SPEEDS:
+            for dy in ASIDE:
+                m = measures(play(env, (AHEAD, dy), plan(speed, press)))
+                result["pushes"][f"{speed},{dy},{press}"] = m
+                print(f"press {press} speed {speed} aside {dy}: near {m['near_steps']} peak {m['peak_speed']} launch"
+                      f" {m['launch_step']} travel {m['travel']}", flush=True)  # fmt: skip
     with open(args.out, "w") as fh:
         json.dump(result, fh, indent=1)
     return 0
