@@ -29,6 +29,12 @@ ACTIONS = (
 )
 
 
+def pressed_puck(offset: float) -> tuple[float, float]:
+    """The puck's x-y from the grip's home for the press at ``offset`` behind its centre (``ACTIONS`` move the grip
+    0.04 m forward before pressing)."""
+    return (0.04 + offset, 0.0)
+
+
 def ours(env, puck_from_home, plan) -> np.ndarray:
     """Observation slots 0:6 (grip xyz, puck xyz) per step of ``plan`` (actions) in our task ``env``, the puck put
     at ``puck_from_home`` (x-y) from the grip's home, [T + 1, 6]."""
@@ -79,7 +85,7 @@ def main(argv=None) -> int:
 
     import_reference()
     env = envs.make("slide", **parse_overrides(args.env_options))
-    puck = (0.04 + args.offset, 0.0)
+    puck = pressed_puck(args.offset)
     sims = {"ours": ours(env, puck, ACTIONS), "fetch": reference(env, puck, ACTIONS)}
     result = {"offset": args.offset, "env_options": args.env_options, "actions": ACTIONS}
     for name, x in sims.items():

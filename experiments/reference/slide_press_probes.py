@@ -128,7 +128,7 @@ def main(argv=None) -> int:
     result = {"env_options": args.env_options, "reference_collider": "libccd" if args.libccd else "native",
               "offsets": {}}
     for offset in () if args.no_press else [float(x) for x in args.offsets.split(",")]:
-        puck = (0.04 + offset, 0.0)
+        puck = probe.pressed_puck(offset)
         row = {"ours": measures(probe.ours(env, puck, probe.ACTIONS))}
         if not args.no_reference:
             row["fetch"] = measures(probe.reference(env, puck, probe.ACTIONS))
