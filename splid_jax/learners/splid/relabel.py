@@ -9,12 +9,7 @@ explored step gives, and the action each is labelled with.
   achieved, so the policy is never shown what to do there and pushes through the goal.
 - ``stop``: ``hold`` with the held pairs labelled with the zero action: on the Fetch tasks the gripper
   holds where it is, so at a goal already reached the policy is taught to stand still rather than to
-  copy exploration noise that happened not to disturb the object.
-- ``land``: ``hold`` and also each explored step's landing goal: where the object lies at the episode's
-  end, if it came to rest there, judged at the final step (kept only if the policy, restored at s_t, is
-  NOT there after the episode's remaining T - t steps). Moved goals at h <= H lie on a struck object's
-  path, so a policy cloned on them alone strikes through its goals; landing goals teach where a strike
-  stops (Slide's puck slides for 16 to 39 steps)."""
+  copy exploration noise that happened not to disturb the object."""
 
 from __future__ import annotations
 
@@ -57,38 +52,11 @@ def held(hs: Hindsight, horizon: jax.Array) -> jax.Array:
     return hs.real & hs.achieved & (hs.h == horizon)[:, None, None]
 
 
-REST_STEPS = 5  # the object counts as at rest when it moved less than REST_DISTANCE over the episode's last steps
-REST_DISTANCE = 0.1  # x the task's success distance
-
-
-class Landing(NamedTuple):
-    """Every explored step's landing goal, in layout [1, T, N]."""
-
-    goal: jax.Array  # [1, T, N, G] m(s_T), where the object came to rest
-    valid: jax.Array  # [1, T, N] bool: the object at rest at the end, not already there at s_t, no NaN
-    h: jax.Array  # [1, T, 1] int32: T - t, the steps to the episode's end
-
-
-def landing(env: GoalEnv, traj: Trajectory) -> Landing:
-    """g' = m(s_T) for every explored t, where the object lies still over the last REST_STEPS steps."""
-    T = env.episode_length
-    last = traj.achieved[T]  # [N, G]
-    drift = jnp.linalg.norm(last - traj.achieved[T - REST_STEPS], axis=-1)
-    still = (drift < REST_DISTANCE * env.success_distance) & ~jnp.any(traj.invalid[T - REST_STEPS :], axis=0)
-    there = env.success(traj.achieved[:T], last[None])  # [T, N] the object already at g' at s_t
-    valid = still[None] & ~there & ~traj.invalid[:T]
-    goal = jnp.broadcast_to(last[None], (T,) + last.shape)
-    h = (T - jnp.arange(T, dtype=jnp.int32))[:, None]
-    return Landing(goal[None], valid[None], h[None])
-
-
 class Strategy(NamedTuple):
-    """A relabelling: its candidates (moved, held), whether the held ones are labelled with the zero action,
-    and whether each explored step adds its landing goal (one more row of candidates)."""
+    """A relabelling: its candidates (moved, held) and whether the held ones are labelled with the zero action."""
 
     candidates: Callable[[Hindsight, jax.Array], tuple[jax.Array, jax.Array]]
     stands_still: bool = False
-    lands: bool = False
 
     def label(self, actions: jax.Array, held: jax.Array) -> jax.Array:
         """[M, A] the action each candidate is cloned with: the explored one, or zero on held goals."""
@@ -105,11 +73,6 @@ def _hold(hs: Hindsight, horizon: jax.Array) -> tuple[jax.Array, jax.Array]:
     return moved(hs, horizon), held(hs, horizon)
 
 
-STRATEGIES = {
-    "paper": Strategy(_paper),
-    "hold": Strategy(_hold),
-    "stop": Strategy(_hold, stands_still=True),
-    "land": Strategy(_hold, lands=True),
-}
+STRATEGIES = {"paper": Strategy(_paper), "hold": Strategy(_hold), "stop": Strategy(_hold, stands_still=True)}
 NAMES = tuple(STRATEGIES)
 HOLDING = tuple(name for name, s in STRATEGIES.items() if s.candidates is _hold)  # add held-goal candidates

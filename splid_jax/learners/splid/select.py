@@ -25,12 +25,11 @@ from splid_jax.common import ticks
 from splid_jax.common.networks import Policy, PolicyState
 from splid_jax.learners.imitation.candidates import Candidates
 from splid_jax.learners.imitation.explore import Trajectory
-from splid_jax.learners.splid.relabel import STRATEGIES, hindsight, landing
+from splid_jax.learners.splid.relabel import STRATEGIES, hindsight
 
 
-def num_candidates(episode_length: int, max_horizon: int, num_envs: int, lands: bool = False) -> int:
-    """H rows of hindsight goals (and one of landing goals where the relabelling lands) x T x N."""
-    return (max_horizon + lands) * episode_length * num_envs
+def num_candidates(episode_length: int, max_horizon: int, num_envs: int) -> int:
+    return max_horizon * episode_length * num_envs
 
 
 def num_lanes(episode_length: int, num_envs: int, lanes: float, max_horizon: int) -> int:
@@ -140,24 +139,15 @@ def select(
     strategy, (T, H, n) = STRATEGIES[relabel], (env.episode_length, max_horizon, traj.actions.shape[1])
     hs = hindsight(env, traj, H)  # lines 12-14: for t = 1..T, h = 1..H: g' = m(s_{t+h})
     moved, held = strategy.candidates(hs, horizon)  # paper: every g' the object moved to, h <= H
-    h = jnp.broadcast_to(hs.h[:, None, None], moved.shape)  # [rows, T, N] each candidate's horizon
-    valid, goal, held = moved | held, hs.goal, held
-    final = held  # verdicts at the final step
-    if strategy.lands:  # one more row: the landing goals, judged at the episode's end
-        lg = landing(env, traj)
-        cat = lambda a, b: jnp.concatenate([a, b], axis=0)  # noqa: E731
-        valid, goal, h = cat(valid, lg.valid), cat(goal, lg.goal), cat(h, jnp.broadcast_to(lg.h, lg.valid.shape))
-        held, final = cat(held, jnp.zeros_like(lg.valid)), cat(final, lg.valid)
-    rows = valid.shape[0]
-    valid, held, final, h_of = valid.reshape(-1), held.reshape(-1), final.reshape(-1), h.reshape(-1)
-    goal = goal.reshape(rows * T * n, -1)
+    valid, held, goal = (moved | held).reshape(-1), held.reshape(-1), hs.goal.reshape(H * T * n, -1)
     reached, steps = jnp.zeros_like(valid), jnp.int32(0)
     if use_select:  # line 15: SELECT(s_t, g'): does the policy, restored at s_t, reach g' within h steps?
         starts = jax.tree_util.tree_map(lambda x: x.reshape((T * n,) + x.shape[2:]), traj.states)
-        start_of, lanes = jnp.arange(rows * T * n, dtype=jnp.int32) % (T * n), num_lanes(T, n, lanes, H)
-        reached, steps = replay_queue(env, policy, pstate, starts, goal, start_of, h_of, valid, lanes, final)
-    tile = lambda x: jnp.broadcast_to(x[None], (rows,) + x.shape).reshape((rows * T * n,) + x.shape[2:])  # noqa: E731
+        flat = jnp.arange(H * T * n, dtype=jnp.int32)
+        start_of, h_of, lanes = flat % (T * n), flat // (T * n) + 1, num_lanes(T, n, lanes, H)
+        reached, steps = replay_queue(env, policy, pstate, starts, goal, start_of, h_of, valid, lanes, held)
+    tile = lambda x: jnp.broadcast_to(x[None], (H,) + x.shape).reshape((H * T * n,) + x.shape[2:])  # noqa: E731
     action = strategy.label(tile(traj.actions), held)  # line 16: store (s_t, g', a_t) where the policy did not
     out = Candidates(tile(traj.states.obs), goal, action, valid, valid & ~reached, held, steps)
-    chex.assert_shape([out.valid, out.accept, out.held], (num_candidates(T, H, n, strategy.lands),))
+    chex.assert_shape([out.valid, out.accept, out.held], (num_candidates(T, H, n),))
     return out

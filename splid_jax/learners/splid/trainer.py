@@ -23,7 +23,6 @@ from splid_jax.learners.imitation.bc import bc_epoch
 from splid_jax.learners.imitation.candidates import Candidates
 from splid_jax.learners.imitation.config import ImitationConfig
 from splid_jax.learners.imitation.explore import Seen, Trajectory, draws, hold_fingers, rollout
-from splid_jax.learners.splid.relabel import STRATEGIES
 from splid_jax.learners.splid.select import select
 
 
@@ -81,7 +80,6 @@ class Trainer(Chunked):
         self.learner = registry.get(cfg.algo)
         # shapes; a sweep's members mask larger h through Hyper.horizon
         self.max_horizon = bc.horizon
-        self.lands = STRATEGIES[bc.relabel].lands and not self.learner.clones_every_pair
         self.pchid_every = max(1, bc.pchid_every)  # TrainConfig resolves 0 for pchid
         allowed = "0 for pchid, whose horizon grows over the run"
         check(not (self.learner.grows_horizon and bc.horizon_end), "horizon_end", bc.horizon_end, allowed)
@@ -169,10 +167,6 @@ class Trainer(Chunked):
             "bc_loss": loss,
             "explore_success": jnp.mean(jnp.any(seen.success, axis=0)),
         }
-        if self.lands:  # the last row of candidates: the landing goals
-            first = self.max_horizon * env.episode_length * cfg.num_envs
-            metrics["select_landing"] = jnp.sum(cands.valid[first:], dtype=jnp.int32)
-            metrics["select_landing_accepted"] = jnp.sum(cands.accept[first:], dtype=jnp.int32)
         new = TrainState(
             policy=pstate, opt_state=opt_state, online=online, buffer=buf, key=key, iteration=ts.iteration + 1
         )
@@ -294,7 +288,7 @@ class Trainer(Chunked):
             bc_steps=jnp.mean(per_iter["bc_steps"].astype(jnp.float32)),
             explore_success=jnp.mean(per_iter["explore_success"]),
             buffer_size=ts.buffer.size,
-        ) | ({k: jnp.sum(per_iter[k]) for k in ("select_landing", "select_landing_accepted")} if self.lands else {})
+        )
 
     def watched(self, ts: TrainState, per_iter: dict) -> tuple:
         return (ts.policy.params, ts.online), jnp.isfinite(per_iter["bc_loss"])

@@ -56,11 +56,11 @@ def _scripted(env, starts, actions) -> Trajectory:
     s0 = jax.vmap(env.reset)(jax.random.split(jax.random.PRNGKey(0), N))
     s0 = s0.replace(physics=starts, obs=starts, achieved_goal=starts)
 
-    def one(s: State, a):
-        nxt = jax.vmap(env.step)(s, a)
-        return nxt, (s, a, nxt.achieved_goal, nxt.invalid)
+    def one(s: State, _):
+        nxt = jax.vmap(env.step)(s, actions)
+        return nxt, (s, actions, nxt.achieved_goal, nxt.invalid)
 
-    _, (states, acts, ag, inv) = jax.lax.scan(one, s0, actions)  # actions [T, N, 2]
+    _, (states, acts, ag, inv) = jax.lax.scan(one, s0, None, length=T)
     return Trajectory(
         states, acts, jnp.concatenate([s0.achieved_goal[None], ag]), jnp.concatenate([s0.invalid[None], inv])
     )
@@ -69,8 +69,9 @@ def _scripted(env, starts, actions) -> Trajectory:
 def scripted_trajectory(env, actions, start=(-4.8, -4.8)) -> Trajectory:
     """Roll fixed per-env actions for T steps from ``start``; envs past the given rows stand still."""
     actions = jnp.asarray(actions, jnp.float32).reshape(-1, 2)
-    per_step = jnp.broadcast_to(jnp.zeros((N, 2)).at[: len(actions)].set(actions), (T, N, 2))
-    return _scripted(env, jnp.broadcast_to(jnp.asarray(start), (N, 2)), per_step)
+    return _scripted(
+        env, jnp.broadcast_to(jnp.asarray(start), (N, 2)), jnp.zeros((N, 2)).at[: len(actions)].set(actions)
+    )
 
 
 def env_of(x):
@@ -197,27 +198,3 @@ def test_stop_labels_the_held_pairs_with_the_zero_action_and_keeps_the_rest(env,
     np.testing.assert_array_equal(action[h], 0.0)
     np.testing.assert_array_equal(action[~h], np.asarray(held.action)[~h])
     assert np.abs(np.asarray(held.action)[np.asarray(held.valid) & ~h]).max() > 0
-
-
-def test_land_adds_where_the_object_came_to_rest_judged_at_the_episode_end(env, policy, run_select):
-    """``relabel=land``: ``hold``'s candidates and one more row, each explored step's landing goal m(s_T),
-    only where the point lay still at the end and was not already there at s_t. A policy that ends there
-    is rejected; one that passes through it and on is kept (the verdict is the final step's)."""
-    moves = jnp.zeros((T, N, 2)).at[:4, 0].set(jnp.array([0.0, 0.4]))  # env 0: 4 steps +y, then rests
-    moves = moves.at[:, 1].set(jnp.array([0.4, 0.0]))  # env 1 never rests; env 2 never moves
-    traj = _scripted(env, jnp.full((N, 2), -4.8), moves)
-    ends, overshoots = constant_policy(policy, [0.0, 0.16]), constant_policy(policy, [0.0, 0.4])
-    held, landed, passed = (run_select(ends, traj, relabel="hold"), run_select(ends, traj, relabel="land"),
-                            run_select(overshoots, traj, relabel="land"))  # fmt: skip
-    m = num_candidates(T, H, N)
-    chex.assert_shape(landed.valid, (num_candidates(T, H, N, lands=True),))
-    np.testing.assert_array_equal(landed.valid[:m], held.valid)
-    np.testing.assert_array_equal(landed.accept[:m], held.accept)
-    row = np.asarray(landed.valid[m:]).reshape(T, N)
-    expected = np.zeros((T, N), bool)
-    expected[:2, 0] = True  # 1.6 and 1.2 from where it rests; from t = 2 on within the success radius
-    np.testing.assert_array_equal(row, expected)
-    np.testing.assert_allclose(np.asarray(landed.goal[m:]).reshape(T, N, 2)[0, 0], [-4.8, -3.2], atol=1e-5)
-    assert not np.asarray(landed.accept[m:]).any()  # 0.16 a step ends on it from t = 0 and t = 1
-    np.testing.assert_array_equal(np.asarray(passed.accept[m:]).reshape(T, N), expected)
-    assert not np.asarray(landed.held[m:]).any()
