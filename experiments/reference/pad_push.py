@@ -2,7 +2,7 @@
 pads stay on the puck and how fast it leaves them. Learnt strikers part from the reference here: where the reference's
 puck overshoots the goal, it leaves the pads within a few steps and faster, while ours is pushed along for many.
 
-    python experiments/reference/pad_push.py --side ours|reference [--env-options K=V,...] --out FILE.json
+    python experiments/reference/pad_push.py --side ours|reference [--env-options K=V,...] [--speeds 0.6,0.8,1.0] --out FILE.json
 
 Each push lowers the pads to the table beside the grip's home (``DOWN`` steps), then drives at ``speed`` x full action
 along +x and ``press`` along z (``PRESSES``: lightly down, or level) for ``PUSH`` steps and holds still for ``REST``
@@ -49,6 +49,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--side", choices=("ours", "reference"), required=True)
     p.add_argument("--env-options", default="", help="our task's fields (the puck's place is computed from them)")
+    p.add_argument("--speeds", default=",".join(map(str, SPEEDS)), help="fractions of full action, comma-separated")
     p.add_argument("--out", required=True)
     args = p.parse_args(argv)
     import envs
@@ -59,7 +60,7 @@ def main(argv=None) -> int:
     play = ours if args.side == "ours" else reference
     result = {"side": args.side, "env_options": args.env_options, "pushes": {}}
     for press in PRESSES:
-        for speed in SPEEDS:
+        for speed in [float(v) for v in args.speeds.split(",")]:
             for dy in ASIDE:
                 m = measures(play(env, (AHEAD, dy), plan(speed, press)))
                 result["pushes"][f"{speed},{dy},{press}"] = m
