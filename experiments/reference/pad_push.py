@@ -2,7 +2,8 @@
 pads stay on the puck and how fast it leaves them. Learnt strikers part from the reference here: where the reference's
 puck overshoots the goal, it leaves the pads within a few steps and faster, while ours is pushed along for many.
 
-    python experiments/reference/pad_push.py --side ours|reference [--env-options K=V,...] [--speeds 0.6,0.8,1.0] --out FILE.json
+    python experiments/reference/pad_push.py --side ours|reference [--env-options K=V,...] [--speeds 0.6,0.8,1.0] \
+        --out FILE.json
 
 Each push lowers the pads to the table beside the grip's home (``DOWN`` steps), then drives at ``speed`` x full action
 along +x and ``press`` along z (``PRESSES``: lightly down, or level) for ``PUSH`` steps and holds still for ``REST``

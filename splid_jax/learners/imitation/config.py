@@ -10,7 +10,7 @@ import dataclasses
 from splid_jax.common.errors import check
 from splid_jax.common.fields import field
 
-RELABELS = ("paper", "hold", "stop")  # splid.relabel.STRATEGIES, named here without importing JAX
+RELABELS = ("paper", "hold", "stop", "exact")  # splid.relabel.STRATEGIES, named here without importing JAX
 GCSL_RELABELS = ("final", "future")
 OPTIMISERS = ("adam", "rmsprop")
 
@@ -58,8 +58,10 @@ class ImitationConfig:
     relabel: str = field(
         None,
         "splid/pchid candidates: paper (Algorithm 2 exactly), hold (also steps whose goal is already "
-        "achieved and held for H steps, kept when the policy is not at the goal after H steps) or stop "
-        "(hold, with the held pairs labelled by the zero action: stand still at a reached goal)",
+        "achieved and held for H steps, kept when the policy is not at the goal after H steps), stop "
+        "(hold, with the held pairs labelled by the zero action: stand still at a reached goal) or exact (hold, "
+        "every verdict at exactly h steps: kept when the policy is not at g' after h steps, so a push that stops "
+        "at g' is kept beside one that passes it sooner)",
     )
     gcsl_relabel: str = field(
         "final", "gcsl: the later goal each step is paired with: final (the episode's last) or future (uniform)"

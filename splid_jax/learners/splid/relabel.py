@@ -9,7 +9,11 @@ explored step gives, and the action each is labelled with.
   achieved, so the policy is never shown what to do there and pushes through the goal.
 - ``stop``: ``hold`` with the held pairs labelled with the zero action: on the Fetch tasks the gripper
   holds where it is, so at a goal already reached the policy is taught to stand still rather than to
-  copy exploration noise that happened not to disturb the object."""
+  copy exploration noise that happened not to disturb the object.
+- ``exact``: ``hold``'s candidates with every verdict taken at exactly h steps: a moved goal counts as reached
+  only if the policy, restored at s_t, is at g' after h steps, not on its way past. The first-hit verdict keeps
+  an explored action only where it got to g' sooner than the policy, so where the object slides on (Slide's
+  puck) it favours the hardest hits; at exactly h a gentler push that stops nearer g' is kept too."""
 
 from __future__ import annotations
 
@@ -53,10 +57,12 @@ def held(hs: Hindsight, horizon: jax.Array) -> jax.Array:
 
 
 class Strategy(NamedTuple):
-    """A relabelling: its candidates (moved, held) and whether the held ones are labelled with the zero action."""
+    """A relabelling: its candidates (moved, held), whether the held ones are labelled with the zero action, and
+    whether every verdict, not only the held goals', is taken at exactly h steps."""
 
     candidates: Callable[[Hindsight, jax.Array], tuple[jax.Array, jax.Array]]
     stands_still: bool = False
+    on_time: bool = False
 
     def label(self, actions: jax.Array, held: jax.Array) -> jax.Array:
         """[M, A] the action each candidate is cloned with: the explored one, or zero on held goals."""
@@ -73,6 +79,11 @@ def _hold(hs: Hindsight, horizon: jax.Array) -> tuple[jax.Array, jax.Array]:
     return moved(hs, horizon), held(hs, horizon)
 
 
-STRATEGIES = {"paper": Strategy(_paper), "hold": Strategy(_hold), "stop": Strategy(_hold, stands_still=True)}
+STRATEGIES = {
+    "paper": Strategy(_paper),
+    "hold": Strategy(_hold),
+    "stop": Strategy(_hold, stands_still=True),
+    "exact": Strategy(_hold, on_time=True),
+}
 NAMES = tuple(STRATEGIES)
 HOLDING = tuple(name for name, s in STRATEGIES.items() if s.candidates is _hold)  # add held-goal candidates

@@ -145,7 +145,8 @@ def select(
         starts = jax.tree_util.tree_map(lambda x: x.reshape((T * n,) + x.shape[2:]), traj.states)
         flat = jnp.arange(H * T * n, dtype=jnp.int32)
         start_of, h_of, lanes = flat % (T * n), flat // (T * n) + 1, num_lanes(T, n, lanes, H)
-        reached, steps = replay_queue(env, policy, pstate, starts, goal, start_of, h_of, valid, lanes, held)
+        at_final = valid if strategy.on_time else held
+        reached, steps = replay_queue(env, policy, pstate, starts, goal, start_of, h_of, valid, lanes, at_final)
     tile = lambda x: jnp.broadcast_to(x[None], (H,) + x.shape).reshape((H * T * n,) + x.shape[2:])  # noqa: E731
     action = strategy.label(tile(traj.actions), held)  # line 16: store (s_t, g', a_t) where the policy did not
     out = Candidates(tile(traj.states.obs), goal, action, valid, valid & ~reached, held, steps)
