@@ -23,7 +23,9 @@ class HerConfig:
         "futureactual_2_2 is replay_k=2, actual_k=2; Baselines' future_4 is replay_k=4, actual_k=0)",
     )
     actual_warm_up: int = field(
-        25_000, "stored transitions before 'actual' goals are drawn; until then their share goes to future goals"
+        25_000,
+        "with actual_k > 0, stored transitions before 'actual' and real goals are drawn: until then every goal is a "
+        "future one (mrl's future_warm_up)",
     )
     gamma: float = field(0.98, "discount; 0.98 for the 50-step episodes (Baselines: 1 - 1/T)")
     hidden: tuple[int, ...] = field((512, 512, 512), "hidden layer widths of the actor and of the critic (ReLU)")

@@ -71,9 +71,9 @@ def sample_transitions(
 ) -> Transitions:
     """A uniform episode and step, and its goal relabelled: with probability ``future_p`` the achieved goal
     of a uniform later step of the same episode (Baselines' and mrl's "future"), with probability ``actual_p``
-    the desired goal of a uniform stored episode (mrl's "actual"; while ``actual_on`` is False this share is
-    relabelled as "future" too), else the episode's own goal. The reward is recomputed. An empty buffer yields
-    slot 0 (callers weight the loss by ``size > 0``)."""
+    the desired goal of a uniform stored episode (mrl's "actual"), else the episode's own goal. With "actual" goals
+    configured, while ``actual_on`` is False every goal is a future one, as in mrl's first ``future_warm_up`` steps.
+    The reward is recomputed. An empty buffer yields slot 0 (callers weight the loss by ``size > 0``)."""
     T = buf.actions.shape[1]
     k_ep, k_t, k_future, k_relabel = jax.random.split(key, 4)
     filled = jnp.maximum(buf.size, 1)
@@ -85,7 +85,8 @@ def sample_transitions(
     u = jax.random.uniform(k_relabel, (batch_size,))
     mixed = u < future_p + actual_p
     actual = mixed & (u >= future_p) & actual_on
-    relabelled = mixed & ~actual
+    warming = ~jnp.asarray(actual_on) if actual_p else jnp.bool_(False)  # mrl: the whole batch future until then
+    relabelled = (mixed & ~actual) | warming
     goal = jnp.where(relabelled[:, None], buf.achieved[ep, future], buf.goal[ep])
     goal = jnp.where(actual[:, None], buf.goal[other], goal)
     return Transitions(
