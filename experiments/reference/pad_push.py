@@ -51,6 +51,8 @@ def main(argv=None) -> int:
     p.add_argument("--side", choices=("ours", "reference"), required=True)
     p.add_argument("--env-options", default="", help="our task's fields (the puck's place is computed from them)")
     p.add_argument("--speeds", default=",".join(map(str, SPEEDS)), help="fractions of full action, comma-separated")
+    p.add_argument("--aside", default=",".join(map(str, ASIDE)), help="the puck's offsets across the push (m)")
+    p.add_argument("--presses", default=",".join(map(str, PRESSES)), help="z actions while pushing")
     p.add_argument("--out", required=True)
     args = p.parse_args(argv)
     import envs
@@ -60,9 +62,10 @@ def main(argv=None) -> int:
         import_reference()
     play = ours if args.side == "ours" else reference
     result = {"side": args.side, "env_options": args.env_options, "pushes": {}}
-    for press in PRESSES:
-        for speed in [float(v) for v in args.speeds.split(",")]:
-            for dy in ASIDE:
+    floats = lambda text: [float(v) for v in text.split(",")]  # noqa: E731
+    for press in floats(args.presses):
+        for speed in floats(args.speeds):
+            for dy in floats(args.aside):
                 m = measures(play(env, (AHEAD, dy), plan(speed, press)))
                 result["pushes"][f"{speed},{dy},{press}"] = m
                 print(f"press {press} speed {speed} aside {dy}: near {m['near_steps']} peak {m['peak_speed']} launch"
