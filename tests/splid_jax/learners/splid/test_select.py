@@ -133,12 +133,13 @@ def _explore(env, policy, pstate, key, sigma):
     return explore(env, policy, pstate, key, N, sigma)
 
 
-@functools.partial(jax.jit, static_argnums=(0, 1))
-def _each_alone(env, policy, pstate, starts, goal):
-    """``policy_reaches`` for every candidate [H * T * N] on its own."""
+@functools.partial(jax.jit, static_argnums=(0, 1, 5))
+def _each_alone(env, policy, pstate, starts, goal, at_final=False):
+    """``policy_reaches`` for every candidate [H * T * N] on its own (``at_final``: at exactly h)."""
     i = jnp.arange(goal.shape[0])
     start = jax.tree_util.tree_map(lambda x: x[i % (T * N)], starts)
-    return jax.vmap(lambda s, g, h: policy_reaches(env, policy, pstate, s, g, h))(start, goal, i // (T * N) + 1)
+    reaches = lambda s, g, h: policy_reaches(env, policy, pstate, s, g, h, at_final=at_final)  # noqa: E731
+    return jax.vmap(reaches)(start, goal, i // (T * N) + 1)
 
 
 def test_work_queue_gives_every_valid_candidate_the_verdict_of_its_own_replay(env, policy, run_select):
@@ -200,16 +201,6 @@ def test_stop_labels_the_held_pairs_with_the_zero_action_and_keeps_the_rest(env,
     assert np.abs(np.asarray(held.action)[np.asarray(held.valid) & ~h]).max() > 0
 
 
-
-@functools.partial(jax.jit, static_argnums=(0, 1))
-def _each_alone_at_h(env, policy, pstate, starts, goal):
-    """``policy_reaches`` at exactly h for every candidate [H * T * N] on its own."""
-    i = jnp.arange(goal.shape[0])
-    start = jax.tree_util.tree_map(lambda x: x[i % (T * N)], starts)
-    at_h = lambda s, g, h: policy_reaches(env, policy, pstate, s, g, h, at_final=True)  # noqa: E731
-    return jax.vmap(at_h)(start, goal, i // (T * N) + 1)
-
-
 def test_exact_takes_every_verdict_at_h_so_a_policy_that_passes_g_prime_sooner_keeps_the_pair(env, policy, run_select):
     """``relabel=exact``: ``hold``'s candidates; a policy at full speed passes the goals a 0.4 push reached, so the
     first-hit verdict rejects every moved pair, and the exact-h one keeps each where the policy is then off g' (not
@@ -222,7 +213,7 @@ def test_exact_takes_every_verdict_at_h_so_a_policy_that_passes_g_prime_sooner_k
     moved = np.asarray(first.valid) & ~np.asarray(first.held)
     assert moved.any() and not np.asarray(first.accept)[moved].any()
     starts = jax.tree_util.tree_map(lambda x: x.reshape((T * N,) + x.shape[2:]), traj.states)
-    expected = np.asarray(exact.valid) & ~np.asarray(_each_alone_at_h(env, policy, fast, starts, exact.goal))
+    expected = np.asarray(exact.valid) & ~np.asarray(_each_alone(env, policy, fast, starts, exact.goal, True))
     np.testing.assert_array_equal(exact.accept, expected)
     assert expected[moved].sum() > moved.sum() // 2
     assert int(exact.replay_steps) > int(first.replay_steps)  # no replay ends at a passing hit
