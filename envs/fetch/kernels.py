@@ -48,7 +48,7 @@ def mjx_with_kernels(task):
     for: the step's only way to the replaced functions. The modules that reach into MJX's private code are imported
     here, so a task on a MuJoCo whose private code moved still imports and runs stock MJX."""
     from envs import box_cylinder, fused_collision, fused_solver, mjx_patch, small_cholesky, solver_loops
-    from envs.fetch import hand_pitch
+    from envs.fetch import hand_pitch, table_edge
 
     backend = jax.default_backend()
     opts = dict(kernel=backend == "gpu", max_envs=task.kernel_envs, num_warps=task.kernel_warps)
@@ -56,8 +56,8 @@ def mjx_with_kernels(task):
         cholesky=small_cholesky.UNROLLED if task.cholesky == "unrolled" else None,
         line_search=solver_loops.written_out_scan if solver_loops.writes_out(task.solver_loops, backend) else None,
         solve=fused_solver.fused(**opts) if runs_as_kernel(task.solver_loops, backend) else None,
-        collide=hand_pitch.wrap(task.mj_model, {**box_cylinder.groups_for(task.mj_model),
-                 **(fused_collision.groups(**opts) if runs_as_kernel(task.collision, backend) else {})}),
+        collide=table_edge.wrap(task.mj_model, hand_pitch.wrap(task.mj_model, {**box_cylinder.groups_for(task.mj_model),
+                 **(fused_collision.groups(**opts) if runs_as_kernel(task.collision, backend) else {})})),
     )
 
 

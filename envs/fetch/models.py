@@ -108,11 +108,12 @@ def workspace_box(kind: str, finger_table: float = 0.0, press: float = FINGER_PR
 
 
 TABLES = ("plane", "box")
+EDGED = "edged"  # Slide's plane top ending at the reference table's edges (envs/fetch/table_edge.py)
 
 
 def tables_for(kind: str) -> tuple[str, ...]:
     """The table shapes task ``kind`` can use: MJX collides Slide's cylinder puck with a plane only."""
-    return ("plane",) if kind == "slide" else TABLES
+    return ("plane", EDGED) if kind == "slide" else TABLES
 
 
 def fingers_for(kind: str) -> tuple[str, ...]:
@@ -183,7 +184,8 @@ def mjcf(
     the table presses on it and drags, as the reference's does under its mocap weld; 0: no such contact.
 
     ``finger_drive`` (PickAndPlace's free fingers): one of ``FINGER_DRIVES``, see there. ``hand_pitch`` (Slide's
-    pads): a custom numeric by which ``envs/fetch/hand_pitch.py`` pitches them as the reference arm stretches."""
+    pads): a custom numeric by which ``envs/fetch/hand_pitch.py`` pitches them as the reference arm stretches;
+    ``table="edged"`` (Slide) one with the table's x-y extent, where ``envs/fetch/table_edge.py`` ends the top."""
     if kind not in _SCENES:
         raise ValueError(f"unknown kind {kind!r}: one of {KINDS}")
     if table not in tables_for(kind):
@@ -228,7 +230,7 @@ def mjcf(
     palm_mass = mass - (2 * FINGER_MASS if free_fingers else 0.0)
     friction = "0.1 0.1 0.005 0.0001 0.0001" if slide else "1 1 0.005 0.0001 0.0001"
     nograv = 'contype="0" conaffinity="0"'
-    plane_top = table == "plane"
+    edged, plane_top = table == EDGED, table in ("plane", EDGED)
     table = f"""<geom name="table" type="box" pos="{_fmt(tx, ty, tz)}" size="{_fmt(hx, hy, hz)}" {nograv}
           rgba="0.6 0.5 0.4 1"/>"""
     if plane_top:  # the top face as a plane: a cheaper contact than box-box, and MJX's only one for a cylinder
@@ -295,7 +297,7 @@ def mjcf(
     </body>"""
         obj_pairs = f"""
     <pair geom1="object" geom2="table" condim="3" friction="{friction}"/>"""
-        if not plane_top:  # on an infinite plane top the object cannot fall to the floor
+        if not plane_top or edged:  # on an infinite plane top the object cannot fall to the floor
             obj_pairs += """
     <pair geom1="object" geom2="floor" condim="3"/>"""
 
@@ -307,7 +309,10 @@ def mjcf(
             for n in names
         )
 
-    custom = f'\n  <custom><numeric name="hand_pitch" data="{hand_pitch:.6g}"/></custom>' if hand_pitch else ""
+    edge = [tx - hx, tx + hx, ty - hy, ty + hy] * edged
+    numerics = {"hand_pitch": [hand_pitch] * bool(hand_pitch), "table_edge": edge}
+    custom = "".join(f'<numeric name="{k}" data="{_fmt(*v)}"/>' for k, v in numerics.items() if v)
+    custom = f"\n  <custom>{custom}</custom>" if custom else ""
     return f"""<mujoco model="fetch_{kind}">
   <compiler angle="radian" autolimits="true"/>{custom}
   <option timestep="{timestep:.6g}" integrator="Euler" solver="Newton" iterations="{iterations}"
@@ -348,9 +353,9 @@ def own_contacts(m: mujoco.MjModel):
     """The block within which MJX knows the contacts model ``m`` needs and it lacks (box-cylinder:
     ``envs/box_cylinder.py``); put_model, make_data and a step's trace of ``m`` must run inside it."""
     from envs import box_cylinder
-    from envs.fetch import hand_pitch
+    from envs.fetch import hand_pitch, table_edge
 
-    groups = hand_pitch.wrap(m, box_cylinder.groups_for(m))
+    groups = table_edge.wrap(m, hand_pitch.wrap(m, box_cylinder.groups_for(m)))
     if not groups:
         return contextlib.nullcontext()
     from envs import mjx_patch

@@ -63,7 +63,7 @@ class _FetchTask(GoalEnv):
     # than the one the kernels were checked on (envs/physics.py).
     physics: str = dataclasses.field(default="kernels", metadata={"numerics_only": True})
     # Parity-study options (experimental): the reference's variants of parts of the physics.
-    # the table's collision shape: its top face as a plane, or the reference's box
+    # the table's collision shape: its top face as a plane (ending at its edges: edged, Slide), or the reference's box
     table: str = experimental("plane")
     # the closed finger block's collision shape (Push: pads, box or capsule, see models.py; Slide: the reference's
     # two box pads (pads, its default) or round tips (box), see envs/fetch/slide_fingers.py)
