@@ -70,3 +70,22 @@ def test_a_puck_past_the_edge_loses_the_table():
     _, (edist, epos) = _contacts(1.96)  # centre past the edge: only the point straight ahead still lies under it
     kept = edist < table_edge.APART
     assert kept.sum() == 1 and epos[kept, 0] == pytest.approx(1.945)
+
+
+def test_on_the_edged_table_a_puck_past_the_edge_falls_to_the_floor_and_one_inside_stays():
+    import jax
+
+    import envs
+
+    env = envs.make("slide", table="edged")
+    o, step = env.layout.object_q, jax.jit(env.step)
+    start = env.reset(jax.random.PRNGKey(0))
+    ends = []
+    for x in (1.93, 1.96):  # the centre 15 mm inside the edge (x 1.945), 15 mm past it
+        qpos = start.physics.qpos.at[o : o + 2].set(jnp.array([x, 0.75]))
+        s = env._state(start.physics.replace(qpos=qpos), start.desired_goal, jnp.int32(0), jnp.bool_(False))
+        for _ in range(15):
+            s = step(s, jnp.zeros(4))
+        ends.append(np.asarray(s.physics.qpos[o : o + 3]))
+    np.testing.assert_allclose(ends[0], (1.93, 0.75, env.layout.object_rest_z), atol=2e-3)
+    assert ends[1][2] < 0.1  # on the floor, 0.4 m below the top
