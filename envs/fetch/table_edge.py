@@ -2,7 +2,7 @@
 
 MJX collides a cylinder with a plane but not with a box, so Slide's table top is a plane, and a plane has no edge:
 a puck struck or carried past FetchSlide-v4's table (x 0.695 to 1.945, y 0.30 to 1.20) slides on in the air, where
-the reference's falls to the floor (experiments/NOTES.md, "Slide at the reference's 2 ms step"). Here each of the
+the reference's falls to the floor (experiments/NOTES.md, "Slide's table edge"). Here each of the
 puck-table contact points (MJX's plane-cylinder gives three on the puck's rim) that lies outside the table's x-y
 extent moves to the table's edge, its depth that of the puck's bottom face there: a puck whose centre is over the
 table keeps its support up to the edge, one half over it tips about the edge, and a point that no longer lies
