@@ -47,8 +47,7 @@ def mjx_with_kernels(task):
     (the kernels up to ``kernel_envs`` envs, with ``kernel_warps`` warps per env), on the backend being traced
     for: the step's only way to the replaced functions. The modules that reach into MJX's private code are imported
     here, so a task on a MuJoCo whose private code moved still imports and runs stock MJX."""
-    from envs import box_cylinder, fused_collision, fused_solver, mjx_patch, small_cholesky, solver_loops
-    from envs.fetch import hand_pitch, table_edge
+    from envs import fused_collision, fused_solver, mjx_patch, small_cholesky, solver_loops
 
     backend = jax.default_backend()
     opts = dict(kernel=backend == "gpu", max_envs=task.kernel_envs, num_warps=task.kernel_warps)
@@ -56,9 +55,21 @@ def mjx_with_kernels(task):
         cholesky=small_cholesky.UNROLLED if task.cholesky == "unrolled" else None,
         line_search=solver_loops.written_out_scan if solver_loops.writes_out(task.solver_loops, backend) else None,
         solve=fused_solver.fused(**opts) if runs_as_kernel(task.solver_loops, backend) else None,
-        collide=table_edge.wrap(task.mj_model, hand_pitch.wrap(task.mj_model, {**box_cylinder.groups_for(task.mj_model),
-                 **(fused_collision.groups(**opts) if runs_as_kernel(task.collision, backend) else {})})),
+        collide=model_contacts(
+            task.mj_model, fused_collision.groups(**opts) if runs_as_kernel(task.collision, backend) else None
+        ),
     )
+
+
+def model_contacts(m, replaced: dict | None = None) -> dict:
+    """The pair functions ({(type1, type2): group}, as ``envs/mjx_patch.py`` takes them) that model ``m`` needs
+    beyond MJX's own: the box-cylinder pair MJX lacks (``envs/box_cylinder.py``), ``replaced`` (faster equivalents
+    of MJX's), and, where ``m`` asks for them, the pitched pads (``hand_pitch.py``) and the table's edges
+    (``table_edge.py``), which wrap whichever function collides their pairs."""
+    from envs import box_cylinder
+    from envs.fetch import hand_pitch, table_edge
+
+    return table_edge.wrap(m, hand_pitch.wrap(m, {**box_cylinder.groups_for(m), **(replaced or {})}))
 
 
 def kernel_fallback(task, error: BaseException) -> str | None:

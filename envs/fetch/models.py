@@ -352,10 +352,9 @@ def rest_height(m: mujoco.MjModel, object_q: int) -> float:
 def own_contacts(m: mujoco.MjModel):
     """The block within which MJX knows the contacts model ``m`` needs and it lacks (box-cylinder:
     ``envs/box_cylinder.py``); put_model, make_data and a step's trace of ``m`` must run inside it."""
-    from envs import box_cylinder
-    from envs.fetch import hand_pitch, table_edge
+    from envs.fetch.kernels import model_contacts
 
-    groups = table_edge.wrap(m, hand_pitch.wrap(m, box_cylinder.groups_for(m)))
+    groups = model_contacts(m)
     if not groups:
         return contextlib.nullcontext()
     from envs import mjx_patch

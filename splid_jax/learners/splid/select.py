@@ -29,6 +29,7 @@ from splid_jax.learners.splid.relabel import STRATEGIES, hindsight
 
 
 def num_candidates(episode_length: int, max_horizon: int, num_envs: int) -> int:
+    """H rows of hindsight goals x T x N."""
     return max_horizon * episode_length * num_envs
 
 
