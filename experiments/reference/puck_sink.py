@@ -1,5 +1,8 @@
 """How far Slide's puck goes down under ``slide_on_puck.py``'s press, in one simulator: the press probe measures
 the grip against the puck, so a puck pressed into the table with the grip on it reads as a press like any other.
+The reference's side alone, with a light press too, is
+``results/2026-11-28/slide-pads/analysis/reference_puck_sink.py``; this one plays the same press in either
+simulator, so our task is measured as the reference is.
 
     python experiments/reference/puck_sink.py --side ours [--env-options timestep=0.002,substeps=20] --out FILE.json
     REF311/bin/python experiments/reference/puck_sink.py --side reference --env-options finger=box,hand_pitch=0 \\
