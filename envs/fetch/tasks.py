@@ -14,11 +14,9 @@ actuator control, which ``Physics`` holds (with ``drive="weld"``, ``simulate`` p
 Newton solver's warm start. Restoring a saved ``State`` and replaying the same actions reproduces the
 trajectory bit for bit, which SELECT's restore-and-replay relies on.
 
-Defaults: 10 substeps of 4 ms (the reference's 20 of 2 ms), Newton with 4 iterations and 4 line-search iterations
-(Slide: 10; with 4 a resting puck crept in float32): half the physics cost, the scripted controllers' success kept.
-
-``physics``: ``kernels`` (the default), parts of the step replaced by equivalents equal to float rounding
-(``envs/fetch/kernels.py``), or ``mjx`` as it is, which a MuJoCo the kernels were not checked on runs.
+Defaults: 10 substeps of 4 ms (the reference's 20 of 2 ms; Slide's), Newton with 4 iterations and 4 line-search
+iterations (Slide: 10): half the physics cost, the scripted controllers' success kept. ``physics``: ``kernels``
+(parts of the step replaced by equivalents equal to float rounding, ``envs/fetch/kernels.py``) or ``mjx`` as it is.
 """
 
 from __future__ import annotations
@@ -347,13 +345,16 @@ class Push(_FetchTask):
 
 @dataclasses.dataclass(frozen=True)
 class Slide(_FetchTask):
-    """Strike a low-friction puck (a cylinder on a plane table top, see models.py) to a goal 0.4 m ahead,
-    out of reach. The fingers are the reference's: box pads (``finger="pads"``, a box-cylinder contact MJX
-    lacks, envs/fetch/slide_fingers.py) that touch the table, pitch back as its hand does at stretch
-    (``hand_pitch``), moved by its weld law with its arm's effective mass, the arm folding back when held at
-    stretch (``arm_drift``): round fingertips let a policy ride the puck, which the reference does not allow, so
-    their policies failed there (experiments/NOTES.md, "Slide with the reference's pads", "The hand's pitch")."""
+    """Strike a low-friction puck (a cylinder on a plane top ending at the reference table's edges) to a goal
+    0.4 m ahead, out of reach, at the reference's 2 ms step (at 4 ms hard strikes went erratically far). The
+    fingers are the reference's box pads (a box-cylinder contact MJX lacks, envs/fetch/slide_fingers.py) that
+    touch the table, pitch back as its hand does at stretch (``hand_pitch``), moved by its weld law with its arm's
+    effective mass, the arm folding back when held at stretch (``arm_drift``): with round fingertips, or no table
+    edge, policies rode the puck and failed in the reference (experiments/NOTES.md, "Slide's table edge")."""
 
+    timestep: float = 0.002
+    substeps: int = 20
+    table: str = "edged"
     finger: str = "pads"
     finger_table: float = 1.0
     drive: str = "weld"
