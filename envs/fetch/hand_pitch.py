@@ -1,8 +1,8 @@
-"""Slide's pads pitched back as the reference arm stretches (task field ``hand_pitch``).
+"""Slide's pads pitched out as the reference arm stretches (task field ``hand_pitch``).
 
 FetchSlide-v4's hand hangs from a 7-joint arm on a mocap weld: as the grip nears the arm's reach its wrist can no
-longer hold the hand upright, and the fingertips swing back toward the robot, 2 degrees at 0.89 m from the reach
-centre, 11 at 0.96, 21 at 1.01, 54 at the reach's edge, whatever the speed or height
+longer hold the hand upright, and the hand leans out with the arm, its fingertips swinging away from the robot, 2
+degrees at 0.89 m from the reach centre, 11 at 0.96, 21 at 1.01, 54 at the reach's edge, whatever the speed or height
 (``experiments/reference/hand_tilt.py``). Our gripper has no arm and stays upright, so a policy pressing the puck
 keeps it there far out, where the reference's tilted pads let it go (experiments/NOTES.md, "The hand's pitch").
 
@@ -32,12 +32,12 @@ GRIP_BELOW_HAND = 0.02  # the grip site below the pads' common centre (slide_fin
 
 def rotation(hand: jnp.ndarray, scale, center=ARM_REACH_CENTER["slide"]) -> jnp.ndarray:
     """[3, 3] the pads' turn for a hand (the pads' common centre) at ``hand``: ``scale`` x the reference's tilt
-    at the grip's reach, the bottom swinging back toward the robot."""
+    at the grip's reach, the bottom swinging out, away from the robot."""
     grip = hand - jnp.array([0.0, 0.0, GRIP_BELOW_HAND])
     off = grip - jnp.asarray(center)
     theta = jnp.deg2rad(scale * jnp.interp(jnp.linalg.norm(off), jnp.asarray(REACH), jnp.asarray(TILT)))
     radial = off[:2] / jnp.maximum(jnp.linalg.norm(off[:2]), 1e-9)
-    k = jnp.array([[0.0, 0.0, radial[0]], [0.0, 0.0, radial[1]], [-radial[0], -radial[1], 0.0]])  # cross(axis, .)
+    k = jnp.array([[0.0, 0.0, -radial[0]], [0.0, 0.0, -radial[1]], [radial[0], radial[1], 0.0]])  # cross(axis, .)
     return jnp.eye(3) + jnp.sin(theta) * k + (1.0 - jnp.cos(theta)) * (k @ k)
 
 

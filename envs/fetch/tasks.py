@@ -96,7 +96,7 @@ class _FetchTask(GoalEnv):
     # The gripper's mass in kg (0: the task's, models.mjcf): how hard the weld drive presses (Slide's pads sink
     # into the puck as deep as the reference's at 22 kg, its arm's effective mass along z at the grip site)
     gripper_mass: float = experimental(0.0, recorded_when_set=True)
-    # Slide's pads pitched back as the reference arm stretches, by this fraction of its hand's tilt (hand_pitch.py)
+    # Slide's pads pitched out as the reference arm stretches, by this fraction of its hand's tilt (hand_pitch.py)
     hand_pitch: float = experimental(0.0, recorded_when_set=True, unrecorded=0.0)
     # Held near its reach, the arm folds back toward its centre: control.DRIFT x this (1.5 the reference's drift)
     arm_drift: float = experimental(0.0, recorded_when_set=True, unrecorded=0.0)
@@ -348,7 +348,7 @@ class Slide(_FetchTask):
     """Strike a low-friction puck (a cylinder on a plane top ending at the reference table's edges) to a goal
     0.4 m ahead, out of reach, at the reference's 2 ms step (at 4 ms hard strikes went erratically far). The
     fingers are the reference's box pads (a box-cylinder contact MJX lacks, envs/fetch/slide_fingers.py) that
-    touch the table, pitch back as its hand does at stretch (``hand_pitch``), moved by its weld law with its arm's
+    touch the table, pitch out as its hand does at stretch (``hand_pitch``), moved by its weld law with its arm's
     effective mass, the arm folding back when held at stretch (``arm_drift``): with round fingertips, or no table
     edge, policies rode the puck and failed in the reference (experiments/NOTES.md, "Slide's table edge")."""
 

@@ -1,4 +1,5 @@
-"""FetchSlide-v4's hand pitches back as its arm stretches; our gripper stays upright.
+"""FetchSlide-v4's hand leans out with its arm as it stretches, the fingertips away from the robot; our gripper stays
+upright.
 
     python experiments/reference/hand_tilt.py [--run RUN --episodes N] --out FILE.json
 
@@ -67,7 +68,7 @@ class Hand:
         return dict(
             reach=float(np.linalg.norm(off)),
             tilt=float(np.degrees(np.arccos(min(1.0, abs(axis[2]))))),
-            along=float(axis[:2] @ radial),  # < 0: the fingertips swing back toward the robot
+            along=float(axis[:2] @ radial),  # < 0: the hand's top leans toward the robot, its fingertips out
             pressed=bool(contacts and grip[2] - puck[2] > 0.01),
             force=float(force),  # the pads' normal force on the puck (N)
             below=bool(grip[2] - puck[2] < 0.01),

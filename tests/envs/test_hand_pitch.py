@@ -28,17 +28,41 @@ def _hand_at(reach: float, heading: float, height: float = 0.42) -> np.ndarray:
 
 
 @pytest.mark.parametrize("heading", [0.0, 0.4])
-def test_the_fingertips_swing_back_toward_the_robot_by_the_reference_tilt(heading):
+def test_the_fingertips_swing_out_away_from_the_robot_by_the_reference_tilt(heading):
     for reach, tilt in ((0.78, 0.9), (0.9625, 11.0), (1.0625, 33.8)):
         r = np.asarray(hand_pitch.rotation(jnp.asarray(_hand_at(reach, heading)), 1.0))
         np.testing.assert_allclose(r @ r.T, np.eye(3), atol=1e-6)
         down = r @ np.array([0.0, 0.0, -1.0])
         assert np.degrees(np.arccos(-down[2])) == pytest.approx(tilt, abs=0.3)
         radial = np.array([np.cos(heading), np.sin(heading)])
-        np.testing.assert_allclose(down[:2], -np.sin(np.radians(tilt)) * radial, atol=3e-3)  # back, not sideways
+        np.testing.assert_allclose(down[:2], np.sin(np.radians(tilt)) * radial, atol=3e-3)  # out, not sideways
     half = np.asarray(hand_pitch.rotation(jnp.asarray(_hand_at(1.0625, heading)), 0.5)) @ np.array([0.0, 0.0, -1.0])
     assert np.degrees(np.arccos(-half[2])) == pytest.approx(33.8 / 2, abs=0.3)
     np.testing.assert_allclose(hand_pitch.rotation(jnp.asarray(_hand_at(1.0625, heading)), 0.0), np.eye(3), atol=1e-7)
+
+
+def test_the_pads_lean_the_way_the_reference_fingers_do_at_stretch():
+    """FetchSlide-v4 driven out to its arm's reach: its fingers' tips (the grip site) lie out from their centres
+    along the radial direction, and our pads turned for that grip lean the same way, by about the same angle."""
+    pytest.importorskip("gymnasium_robotics")
+    from splid_jax.reference.extra import make_reference
+    from splid_jax.reference.mapping import reference_shift
+
+    ref = make_reference("slide")
+    ref.reset(seed=0)
+    for _ in range(10):
+        ref.step(np.array([1.0, 0.0, 0.0, 0.0]))
+    m, d = ref.unwrapped.model, ref.unwrapped.data
+    grip = d.site_xpos[m.site("robot0:grip").id] - reference_shift(envs.make("slide"), ref)
+    fingers = [m.geom(f"robot0:{s}_gripper_finger_link").id for s in "rl"]
+    tip = d.site_xpos[m.site("robot0:grip").id] - d.geom_xpos[fingers].mean(axis=0)  # centre to tips
+    ref.close()
+    radial = (grip - CENTER)[:2] / np.linalg.norm((grip - CENTER)[:2])
+    theirs = np.degrees(np.arctan2(tip[:2] @ radial, -tip[2]))
+    down = np.asarray(hand_pitch.rotation(jnp.asarray(grip + [0.0, 0.0, hand_pitch.GRIP_BELOW_HAND]), 1.0))[:, 2] * -1
+    ours = np.degrees(np.arctan2(down[:2] @ radial, -down[2]))
+    assert theirs > 5.0  # out, at a reach where the lean is several degrees
+    assert ours == pytest.approx(theirs, abs=4.0)
 
 
 def test_the_puck_meets_the_turned_pads():
@@ -58,11 +82,11 @@ def test_the_puck_meets_the_turned_pads():
     geom = jnp.asarray([[puck, p] for p in pads])
     dist, pos, frame = groups[key](mx, dx, key, geom)
     # the same pads turned here about their centre by the reference's tilt at its grip's reach (about 18.5 degrees
-    # at 1.0 m), their bottoms toward -x
+    # at 1.0 m), their bottoms toward +x
     centre = d.geom_xpos[pads].mean(axis=0)
     reach = np.linalg.norm(centre - [0.0, 0.0, hand_pitch.GRIP_BELOW_HAND] - CENTER)
     quat, tilt = np.zeros(4), np.radians(np.interp(reach, hand_pitch.REACH, hand_pitch.TILT))
-    mujoco.mju_axisAngle2Quat(quat, np.array([0.0, 1.0, 0.0]), tilt)
+    mujoco.mju_axisAngle2Quat(quat, np.array([0.0, 1.0, 0.0]), -tilt)
     turn = np.zeros(9)
     mujoco.mju_quat2Mat(turn, quat)
     turn = turn.reshape(3, 3)
