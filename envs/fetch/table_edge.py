@@ -6,9 +6,9 @@ the reference's falls to the floor (experiments/NOTES.md, "Slide's table edge").
 puck-table contact points (MJX's plane-cylinder gives three on the puck's rim) that lies outside the table's x-y
 extent moves to the table's edge, its depth that of the puck's bottom face there: a puck whose centre is over the
 table keeps its support up to the edge, one half over it tips about the edge, and a point that no longer lies
-under the puck's bottom face (the puck past the edge) or lies deep under the top (``BELOW_TOP``) is dropped, so
-the puck falls to the floor. Carried by the model as a custom numeric (x0, x1, y0, y1), so a model's own contacts
-know it (``wrap``).
+under the puck's bottom face (the puck past the edge) or, on a puck over the edge, lies deep under the top
+(``BELOW_TOP``) is dropped, so the puck falls to the floor; a puck pressed deep well inside keeps its support.
+Carried by the model as a custom numeric (x0, x1, y0, y1), so a model's own contacts know it (``wrap``).
 """
 
 from __future__ import annotations
@@ -46,10 +46,13 @@ def edged(group, table: int, extent: tuple[float, float, float, float]):
         deeper = -jnp.sum(axis[:, :2] * shift, axis=1) / jnp.maximum(axis[:, 2], 0.1)  # the bottom face's rise there
         bottom = d.geom_xpos[puck] - axis * m.geom_size[puck, 1:2]  # the bottom face's centre
         moved_far = jnp.linalg.norm(edge - bottom[:, :2], axis=1) > m.geom_size[puck, 0] + 1e-4
-        under = ~(jnp.any(shift != 0, axis=1) & moved_far)
+        past = jnp.any(shift != 0, axis=1)  # the point lies beyond the table's extent
+        under = ~(past & moved_far)
+        # over the edge: a pair with a point past the edge (a puck pressed deep well inside keeps its support)
+        overhang = jnp.repeat(jnp.any(past.reshape(-1, group.ncon), axis=1), group.ncon)
         moved = jnp.concatenate([edge, pos[:, 2:] + deeper[:, None] / 2], axis=1)
         depth = dist + deeper
-        kept = under & (depth > -BELOW_TOP)
+        kept = under & ((depth > -BELOW_TOP) | ~overhang)
         dist = jnp.where(with_table, jnp.where(kept, depth, APART), dist)
         return dist, jnp.where(with_table[:, None], moved, pos), frame
 

@@ -17,15 +17,15 @@ KEY = (GeomType.PLANE, GeomType.CYLINDER)
 OPTIONS = dict(finger="pads", finger_table=1.0, drive="weld", hand_pitch=1.0)
 
 
-def _contacts(x: float, tilt: float = 0.0):
+def _contacts(x: float, tilt: float = 0.0, z: float = 0.42):
     """MJX's own and the edged puck-table contacts (dist [3], pos [3, 3]) for the puck's centre at ``x`` (y 0.75,
-    resting height), turned ``tilt`` radians about +y."""
+    height ``z``: resting at 0.42), turned ``tilt`` radians about +y."""
     m = models.build("slide", table="edged", **OPTIONS)[0]
     d = mujoco.MjData(m)
     o = m.joint("object").qposadr[0]
     quat = np.zeros(4)
     mujoco.mju_axisAngle2Quat(quat, np.array([0.0, 1.0, 0.0]), tilt)
-    d.qpos[o : o + 7] = (x, 0.75, 0.42, *quat)
+    d.qpos[o : o + 7] = (x, 0.75, z, *quat)
     mujoco.mj_kinematics(m, d)
     with models.own_contacts(m):
         mx, dx = mjx.put_model(m), mjx.put_data(m, d)
@@ -47,6 +47,13 @@ def test_the_edged_table_carries_the_reference_tables_extent_and_the_floor_under
 
 def test_a_puck_well_on_the_table_keeps_mjxs_own_contacts():
     (dist, pos), (edist, epos) = _contacts(1.5, tilt=0.02)
+    np.testing.assert_array_equal(edist, dist)
+    np.testing.assert_array_equal(epos, pos)
+
+
+def test_a_puck_pressed_deep_into_the_table_well_inside_keeps_its_support():
+    (dist, pos), (edist, epos) = _contacts(1.5, tilt=0.02, z=0.41)  # 10 mm into the top, as a hard press can drive it
+    assert np.all(dist < -table_edge.BELOW_TOP)
     np.testing.assert_array_equal(edist, dist)
     np.testing.assert_array_equal(epos, pos)
 
