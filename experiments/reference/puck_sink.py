@@ -25,8 +25,7 @@ sys.path.insert(0, HERE)
 sys.path.insert(1, os.path.join(HERE, "..", ".."))
 
 import slide_on_puck  # noqa: E402
-
-OFFSETS = (0.0, 0.01, 0.02)
+from slide_press_probes import OFFSETS  # noqa: E402
 
 
 def main(argv=None) -> int:
