@@ -29,10 +29,10 @@ ACTIONS = (
 )
 
 
-def pressed_puck(offset: float) -> tuple[float, float]:
-    """The puck's x-y from the grip's home for the press at ``offset`` behind its centre (``ACTIONS`` move the grip
-    0.04 m forward before pressing)."""
-    return (0.04 + offset, 0.0)
+def pressed_puck(offset: float, lateral: float = 0.0) -> tuple[float, float]:
+    """The puck's x-y from the grip's home for the press at ``offset`` behind its centre and ``lateral`` to its side
+    (``ACTIONS`` move the grip 0.04 m forward before pressing)."""
+    return (0.04 + offset, lateral)
 
 
 def ours(env, puck_from_home, plan) -> np.ndarray:

@@ -8,7 +8,8 @@ Per offset and simulator: ``grip_on_puck``, the grip's height above the puck's c
 down (steps 4 to 10), and ``grip_dragging``, its mean over the 8 steps driven forward while pressed (11 to 18);
 ``drag_per_step``, the puck's mean x advance per control step over those 8; ``puck_moved``, its x advance by the
 probe's end; ``off``, whether the grip ended below the puck's top face plus the fingertips' reach (the fingers
-beside the puck, not on it).
+beside the puck, not on it); ``puck_aside``, its y move by the end. ``--lateral``: the press also off the puck's
+centre line (m to its side), where the reference's pressed puck leaves sideways and ours stays centred.
 
 ``--strike N``: the scripted strike (``envs.fetch.scripted.slide``) in our task on N episodes
 (``experiments/parity/run_ours.py``), beside the reference's 200 recorded in
@@ -49,6 +50,7 @@ def measures(x: np.ndarray) -> dict:
         "drag_per_step": round(float(np.diff(puck[10:19]).mean()), 4),
         "puck_moved": round(float(puck[-1]), 4),
         "off": bool(above[-1] < ON_TOP),
+        "puck_aside": round(float(x[-1, 4] - x[0, 4]), 4),
     }
 
 
@@ -106,6 +108,7 @@ def main(argv=None) -> int:
     p.add_argument("--env-options", default="", help="our task's fields, e.g. finger=pads,finger_table=1")
     p.add_argument("--no-reference", action="store_true", help="ours only")
     p.add_argument("--offsets", default=",".join(map(str, OFFSETS)), help="comma-separated, m behind the centre")
+    p.add_argument("--lateral", default="0", help="comma-separated, m to the side of the puck's centre line")
     p.add_argument("--strike", type=int, default=0, metavar="N", help="also the scripted strike on N episodes")
     p.add_argument("--no-press", action="store_true", help="the strike only")
     p.add_argument("--libccd", action="store_true",
@@ -127,14 +130,16 @@ def main(argv=None) -> int:
             probe.make_reference = lambda task: _with_libccd(make_reference(task))
     result = {"env_options": args.env_options, "reference_collider": "libccd" if args.libccd else "native",
               "offsets": {}}
-    for offset in () if args.no_press else [float(x) for x in args.offsets.split(",")]:
-        puck = probe.pressed_puck(offset)
+    presses = [(float(x), float(y)) for x in args.offsets.split(",") for y in args.lateral.split(",")]
+    for offset, lateral in () if args.no_press else presses:
+        puck = probe.pressed_puck(offset, lateral)
         row = {"ours": measures(probe.ours(env, puck, probe.ACTIONS))}
         if not args.no_reference:
             row["fetch"] = measures(probe.reference(env, puck, probe.ACTIONS))
-        result["offsets"][str(offset)] = row
+        result["offsets"][str(offset) if lateral == 0 else f"{offset}, {lateral} aside"] = row
         for name, m in row.items():
-            print(f"offset {offset:.4f} {name:5s} " + " ".join(f"{k}={v}" for k, v in m.items()), flush=True)
+            values = " ".join(f"{k}={v}" for k, v in m.items())
+            print(f"offset {offset:.4f} aside {lateral:.4f} {name:5s} {values}", flush=True)
     if args.strike:
         result["strike"] = strike(options, args.strike, args.libccd)
         for name, m in result["strike"].items():
