@@ -26,13 +26,20 @@ import envs  # noqa: E402
 from splid_jax.reference.extra import import_reference, make_reference  # noqa: E402
 
 
+def turn_puck(m, d, yaw_degrees: float) -> int:
+    """FetchSlide-v4's puck turned to ``yaw_degrees`` about its axis from the identity (positions not recomputed);
+    the address of its free joint in ``qpos``."""
+    q = m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "object0:joint")]
+    half = np.radians(yaw_degrees) / 2
+    d.qpos[q + 3 : q + 7] = [np.cos(half), 0.0, 0.0, np.sin(half)]
+    return q
+
+
 def press(task, offset: float, yaw_degrees: float) -> tuple[float, float, float]:
     env = make_reference("slide")
     probe.place_puck(task, env, probe.pressed_puck(offset))
     m, d = env.unwrapped.model, env.unwrapped.data
-    q = m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "object0:joint")]
-    half = np.radians(yaw_degrees) / 2
-    d.qpos[q + 3 : q + 7] = [np.cos(half), 0.0, 0.0, np.sin(half)]
+    q = turn_puck(m, d, yaw_degrees)
     mujoco.mj_forward(m, d)
     start = d.qpos[q : q + 2].copy()
     trace = np.array([env.step(np.asarray(a, np.float64))[0]["observation"][:6] for a in probe.ACTIONS])

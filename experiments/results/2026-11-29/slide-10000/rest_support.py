@@ -16,6 +16,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "..", ".."))
 sys.path.insert(1, os.path.join(HERE, "..", "..", "..", "reference"))
 
+from press_yaw import turn_puck  # noqa: E402
 from slide_on_puck import place_puck  # noqa: E402
 
 import envs  # noqa: E402
@@ -28,10 +29,8 @@ def main() -> int:
     place_puck(envs.make("slide"), env, (0.15, 0.1))
     m, d = env.unwrapped.model, env.unwrapped.data
     puck = next(g for g in range(m.ngeom) if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_CYLINDER)
-    q = m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "object0:joint")]
     for yaw in (0, 10, 22.5, 45, 90, 200):
-        half = np.radians(yaw) / 2
-        d.qpos[q + 3 : q + 7] = [np.cos(half), 0.0, 0.0, np.sin(half)]
+        q = turn_puck(m, d, yaw)
         d.qpos[q + 2] -= 0.0005
         mujoco.mj_forward(m, d)
         frame = d.geom_xmat[puck].reshape(3, 3)
