@@ -23,6 +23,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from splid_jax.common.images import save_figure  # noqa: E402
+
 STEPS_PER_EPISODE = 50
 # (environment steps, final-step success) read off mrl's plots; "FA" is its futureactual_2_2 relabelling
 _PUSH_FA = [(0.25e6, 0.85), (0.28e6, 0.95), (0.5e6, 0.99)]
@@ -103,7 +105,7 @@ def main() -> None:
         top.set_xlabel("episodes (thousands)")
         ax.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
-    fig.savefig(os.path.join(args.out, "her_vs_mrl.png"), dpi=110)
+    save_figure(fig, os.path.join(args.out, "her_vs_mrl.png"), dpi=110)
     with open(os.path.join(args.out, "her_vs_mrl.csv"), "w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(["task", "run", "episodes", "env_steps", "success_any", "success_final"])

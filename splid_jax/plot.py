@@ -28,6 +28,7 @@ from matplotlib.ticker import EngFormatter  # no pyplot: no global backend state
 
 from splid_jax.cli import Parser  # noqa: E402
 from splid_jax.common import stats  # noqa: E402
+from splid_jax.common.images import save_figure  # noqa: E402
 from splid_jax.common.paths import unreadable  # noqa: E402
 from splid_jax.common.stats import smooth  # noqa: E402
 from splid_jax.config import PROVENANCE, TrainConfig  # noqa: E402
@@ -282,7 +283,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if os.path.dirname(out):
             os.makedirs(os.path.dirname(out), exist_ok=True)
-        figure(runs, ns.smooth, ns.group, ns.steps).savefig(out, dpi=110)
+        save_figure(figure(runs, ns.smooth, ns.group, ns.steps), out, dpi=110)
     except OSError as e:
         print(f"{parser.prog}: error: cannot write {out}: {e.strerror or e}", file=sys.stderr)
         return 2

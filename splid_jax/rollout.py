@@ -23,6 +23,7 @@ import numpy as np  # noqa: E402
 from envs.base import step_batch  # noqa: E402
 from splid_jax.cli import Parser, add_compile_cache_flag, flag_error, use_compile_cache  # noqa: E402
 from splid_jax.common.errors import InvalidConfig  # noqa: E402
+from splid_jax.common.images import save_figure  # noqa: E402
 from splid_jax.common.paths import unreadable  # noqa: E402
 from splid_jax.common.subgoals import steered  # noqa: E402
 from splid_jax.config import TrainConfig  # noqa: E402
@@ -333,7 +334,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     title = f"{cfg.env}: iteration {step}"
     paths = f"{title}, {a.episodes} episodes, success {succ.any(axis=0).mean():.2f} at any step"
-    paths_figure(env, states, paths).savefig(figure, dpi=110, bbox_inches="tight")
+    save_figure(paths_figure(env, states, paths), figure, dpi=110, bbox_inches="tight")
     print(f"paths: {figure}")
     if not mujoco_task:
         return 0

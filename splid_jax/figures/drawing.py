@@ -11,6 +11,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import EngFormatter
 
 from splid_jax.common.errors import check
+from splid_jax.common.images import save_figure
 from splid_jax.figures.record import load_record
 from splid_jax.figures.registry import SPECS
 from splid_jax.figures.series import Series, load_series
@@ -77,7 +78,7 @@ def render(out: str, quiet: bool = False) -> tuple[str, str]:
     check(bool(series), "out", out, "a figure directory with at least one evaluation in its runs")
     stem = os.path.join(out, f"{record['figure']}-{record['env']}")
     write_csv(stem + ".csv", series, record)
-    draw(record, series).savefig(stem + ".png", dpi=120)
+    save_figure(draw(record, series), stem + ".png", dpi=120)
     missing = [m for m in record["methods"] if m not in {s.method for s in series}]
     if missing:
         progress.show(f"not drawn (no evaluation yet): {', '.join(missing)}", quiet)
