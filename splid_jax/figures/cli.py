@@ -6,6 +6,7 @@ import argparse
 import contextlib
 import datetime
 import io
+import json
 import os
 import shlex
 import sys
@@ -99,7 +100,11 @@ def build_parser() -> Parser:
         "--out", default=None, metavar="DIR", help="a new or empty directory (default experiments/results/DATE/FIG-ENV)"
     )
     parser.add_argument("--replot", action="store_true", help="redraw the figure and CSV in --out from its runs")
-    parser.add_argument("--resume", action="store_true", help="continue the figure in --out where its runs stopped")
+    parser.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue the figure in --out where its runs stopped, side by side if it was started so",
+    )
     parser.add_argument(
         "--merge",
         nargs="+",
@@ -140,6 +145,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         else os.path.join("experiments", "results", today, f"{ns.figure}-{env_name}")
     )
     use_compile_cache(ns.compile_cache)
+    if ns.resume and not ns.side_by_side:  # a figure resumes as it was started: its methods at once, or in turn
+        ns.side_by_side = started_side_by_side(out)
     if ns.side_by_side:  # before this process first touches the GPU
         share_gpu_memory()
     try:
@@ -221,6 +228,19 @@ def new_record(ns: argparse.Namespace, spec, env_name: str, out: str, today: str
         "command": shlex.join(["python", "-m", "splid_jax.figures", *argv]),
         "runs": describe(plans),
     }
+
+
+def started_side_by_side(out: str) -> bool:
+    """Whether the figure in ``out`` was started with --side-by-side; False where no readable record says so
+    (the resume itself then names what is missing)."""
+    with (
+        contextlib.suppress(OSError, SystemExit, ValueError, TypeError, KeyError),
+        contextlib.redirect_stderr(io.StringIO()),
+    ):
+        with open(os.path.join(out, "figure.json")) as fh:
+            command = json.load(fh)["command"]
+        return bool(build_parser().parse_args(shlex.split(command)[3:]).side_by_side)
+    return False
 
 
 def check_unchanged(ns: argparse.Namespace, record: dict, out: str, mode: str) -> dict:

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from splid_jax import figures
+from splid_jax.figures import cli as figure_cli
 from splid_jax.figures import runs as figure_runs
 from splid_jax.runtime import loop
 
@@ -263,3 +264,26 @@ def test_a_merged_sweep_resumes_each_part_with_its_own_shapes(tmp_path, monkeypa
     assert figures.main(["fig4", "--merge", *map(str, parts), "--out", str(out), "--quiet"]) == 0
     assert figures.main(["fig4", "--resume", "--out", str(out), "--quiet"]) == 0
     assert calls == [(str(out / "splid" / "part0"), 16, [16], 2), (str(out / "splid" / "part1"), 4, [2, 4], 4)]
+
+
+@pytest.mark.parametrize("started", [["--side-by-side"], []])
+def test_a_figure_resumes_side_by_side_only_if_it_was_started_so(tmp_path, monkeypatch, started):
+    out, trained = tmp_path / "out", []
+
+    def stopped(*args, **kwargs):
+        raise loop.Interrupted(15)
+
+    def trains(how):
+        def train(out, record, quiet, resume=False):
+            trained.append((how, resume))
+            figure_runs.train(out, record, quiet, resume=resume)  # writes the record, then stops
+
+        return train
+
+    monkeypatch.setattr(loop, "run", stopped)
+    monkeypatch.setattr(figure_cli, "train", trains("in turn"))
+    monkeypatch.setattr(figure_cli, "train_side_by_side", trains("side by side"))
+    assert figures.main(["fig3", "--methods", "gcsl", *started, "--out", str(out), *QUICK]) == 143
+    assert figures.main(["fig3", "--resume", "--out", str(out), "--quiet"]) == 143
+    how = "side by side" if started else "in turn"
+    assert trained == [(how, False), (how, True)]
