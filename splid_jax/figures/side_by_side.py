@@ -224,5 +224,13 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
+def run(argv: list[str] | None = None) -> None:
+    """The child process: after a signal it ends at once with its code (``exit_with``), not through Python's
+    shutdown, which a chunk still running in a worker thread turns into an abort once the checkpoint is written."""
+    from splid_jax.cli import exit_with
+
+    exit_with(main(argv))
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run()

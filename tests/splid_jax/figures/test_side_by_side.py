@@ -145,3 +145,20 @@ def test_a_child_asked_for_a_part_the_method_lacks_is_one_line(tmp_path, capsys)
     (tmp_path / "figure.json").write_text(json.dumps(split))
     assert side_by_side.main([str(tmp_path), "her", "--part", "seeds-0-1"]) == 2
     assert capsys.readouterr().err.strip().endswith(f"no method 'her' part 'seeds-0-1' in {tmp_path}")
+
+
+@pytest.mark.parametrize("code, at_once", [(143, True), (130, True), (0, False), (3, False)])
+def test_an_interrupted_child_ends_at_once_not_through_pythons_shutdown(monkeypatch, code, at_once):
+    ended = []
+
+    def exit_now(status):
+        ended.append(status)
+        raise SystemExit(status)
+
+    monkeypatch.setattr(side_by_side, "main", lambda argv=None: code)
+    monkeypatch.setattr(os, "_exit", exit_now)
+    monkeypatch.setattr(signal, "signal", lambda sig, handler: None)  # this process's handlers stay as they are
+    with pytest.raises(SystemExit) as stop:
+        side_by_side.run([])
+    assert stop.value.code == code
+    assert ended == ([code] if at_once else [])
