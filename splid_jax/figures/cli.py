@@ -6,7 +6,6 @@ import argparse
 import contextlib
 import datetime
 import io
-import json
 import os
 import shlex
 import sys
@@ -145,8 +144,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         else os.path.join("experiments", "results", today, f"{ns.figure}-{env_name}")
     )
     use_compile_cache(ns.compile_cache)
-    if ns.resume and not ns.side_by_side:  # a figure resumes as it was started: its methods at once, or in turn
-        ns.side_by_side = started_side_by_side(out)
     if ns.side_by_side:  # before this process first touches the GPU
         share_gpu_memory()
     try:
@@ -165,6 +162,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                 mode = "resume" if ns.resume else "replot"
                 record = check_unchanged(ns, load_record(out, mode), out, mode)
                 if ns.resume:
+                    first = started_command(record)  # a figure resumes as it was started: at once, or in turn
+                    if not side and first is not None and first.side_by_side:
+                        side = True
+                        share_gpu_memory()  # nothing has touched the GPU yet
                     (train_side_by_side if side else train)(out, record, ns.quiet, resume=True)
             else:
                 record = new_record(ns, spec, env_name, out, today, argv)
@@ -230,17 +231,12 @@ def new_record(ns: argparse.Namespace, spec, env_name: str, out: str, today: str
     }
 
 
-def started_side_by_side(out: str) -> bool:
-    """Whether the figure in ``out`` was started with --side-by-side; False where no readable record says so
-    (the resume itself then names what is missing)."""
-    with (
-        contextlib.suppress(OSError, SystemExit, ValueError, TypeError, KeyError),
-        contextlib.redirect_stderr(io.StringIO()),
-    ):
-        with open(os.path.join(out, "figure.json")) as fh:
-            command = json.load(fh)["command"]
-        return bool(build_parser().parse_args(shlex.split(command)[3:]).side_by_side)
-    return False
+def started_command(record: dict) -> argparse.Namespace | None:
+    """The command that started the figure in ``record``, parsed as today's parser reads it; None where it no
+    longer parses (a record of an older version)."""
+    with contextlib.suppress(SystemExit, ValueError, TypeError, KeyError), contextlib.redirect_stderr(io.StringIO()):
+        return build_parser().parse_args(shlex.split(record["command"])[3:])
+    return None
 
 
 def check_unchanged(ns: argparse.Namespace, record: dict, out: str, mode: str) -> dict:
@@ -248,8 +244,8 @@ def check_unchanged(ns: argparse.Namespace, record: dict, out: str, mode: str) -
     a figure as it was started, so a setting given anew must be the one it was started with."""
     check(ns.figure == record["figure"], "figure", ns.figure, f"{record['figure']}, the figure in {out}")
     started = {"env": record.get("env"), "seeds": record.get("seeds"), "episodes": record.get("budget_episodes")}
-    with contextlib.suppress(SystemExit, ValueError, TypeError, KeyError), contextlib.redirect_stderr(io.StringIO()):
-        first = build_parser().parse_args(shlex.split(record["command"])[3:])
+    first = started_command(record)
+    if first is not None:
         started |= {"set": first.set, "values": first.values, "methods": first.methods, "quick": first.quick}
     for name in ("env", "methods", "seeds", "episodes", "values", "set", "quick"):
         given, default = getattr(ns, name), build_parser().get_default(name)
