@@ -44,8 +44,8 @@ PRESETS = {
 _POINT = dict(
     relabel="paper", horizon=8, horizon_end=0, iterations=100, select_lanes=1.0, num_envs=32, buffer_size=200_000,
     buffer_window=0, buffer_window_grow=0, batch_size=256, bc_steps=100, bc_reuse=0.0, learning_rate=1e-3,
-    optimiser="adam", policy_ema=0.0, hidden=(64, 64, 64), normalise=True, relative_goal=False, sigma_end=1.0,
-    sigma_anneal=1, eval_every=5, eval_episodes=200, eval_subgoal_reach=0.0, explore_subgoal_reach=0.0,
+    held_share=0.0, optimiser="adam", policy_ema=0.0, hidden=(64, 64, 64), normalise=True, relative_goal=False,
+    sigma_end=1.0, sigma_anneal=1, eval_every=5, eval_episodes=200, eval_subgoal_reach=0.0, explore_subgoal_reach=0.0,
 )  # fmt: skip
 _FETCH = {**_POINT, "iterations": 200, "num_envs": 256, "buffer_size": 1_000_000, "batch_size": 1024}
 _FETCH.update(bc_steps=200, hidden=(256, 256, 256), eval_episodes=500)

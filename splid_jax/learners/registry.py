@@ -51,6 +51,7 @@ _IMITATION = dict(
         "gripper_hold",
         "explore_subgoal_reach",
         "bc_reuse",
+        "held_share",
         "buffer_window",
         "buffer_window_grow",
     ),

@@ -79,6 +79,8 @@ def test_select_lanes_outside_zero_to_the_horizon_names_the_field(lanes):
         {"bc_reuse": -1.0},
         {"buffer_window_grow": -1, "buffer_window": 5_000},
         {"buffer_window_grow": 100},  # without a window: the whole buffer already
+        {"held_share": 1.0, "relabel": "stop"},
+        {"held_share": 0.2, "relabel": "hold"},  # only stop's held pairs carry the zero action
     ],
 )
 def test_a_buffer_window_beyond_the_buffer_or_a_negative_reuse_names_the_field(fields):
@@ -86,6 +88,7 @@ def test_a_buffer_window_beyond_the_buffer_or_a_negative_reuse_names_the_field(f
         TrainConfig(env="point", **fields)
     assert TrainConfig(env="point", buffer_size=20_000, buffer_window=5_000, bc_reuse=30.0).buffer_window == 5_000
     assert TrainConfig(env="point", buffer_size=20_000, buffer_window=5_000, buffer_window_grow=40).buffer_window_grow
+    assert TrainConfig(env="push", held_share=0.2).held_share == 0.2  # Push's default relabelling is stop
 
 
 def test_gripper_hold_is_checked_against_the_task():

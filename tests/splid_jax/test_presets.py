@@ -105,7 +105,7 @@ def test_the_paper_preset_clones_with_rmsprop():
 def test_the_relabellings_named_in_the_config_are_selects_strategies():
     assert RELABELS == relabel.NAMES and relabel.HOLDING == ("hold", "stop", "exact")
     fields = {f.name for f in TrainConfig.settings_fields()}
-    assert not fields & {"hold_horizon", "rest_horizon", "select_radius", "held_share"}  # retired
+    assert not fields & {"hold_horizon", "rest_horizon", "select_radius"}  # retired
 
 
 def test_the_run_config_holds_the_runs_settings_and_each_learners_own_apart():

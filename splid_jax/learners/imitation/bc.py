@@ -57,18 +57,21 @@ def bc_epoch(
     acting_step: float | jax.Array = 1.0,
     active: jax.Array | None = None,
     window: jax.Array | None = None,
+    held_share: jax.Array | float | None = None,
 ):
     """``num_steps`` minibatch steps from the buffer; returns (pstate, opt_state, online, mean loss).
     With ``active`` ([] int, traced) only the first ``active`` steps update: the rest are no-ops, so the shapes
     stay static and each step draws the minibatch it draws with all steps taken. ``window``: batches come
-    from the newest ``window`` pairs (``relabel_buffer.sample``)."""
+    from the newest ``window`` pairs (``relabel_buffer.sample``). ``held_share``: that share of each batch comes
+    from the window's zero-action (held) pairs (``relabel_buffer.held_slots``)."""
     weight = (buf.size > 0).astype(jnp.float32)
+    held = None if held_share is None else relabel_buffer.held_slots(buf, window)
     taken = jnp.ones((num_steps,), bool) if active is None else jnp.arange(num_steps) < active
 
     def one(carry, step):
         ps, os, on = carry
         k, take = step
-        batch = relabel_buffer.sample(buf, k, batch_size, window)
+        batch = relabel_buffer.sample(buf, k, batch_size, window, held, held_share)
         ps, os, on, loss = bc_step(policy, optimiser, ps, os, batch, weight * take, on, acting_step)
         return (ps, os, on), loss
 

@@ -105,6 +105,14 @@ class ImitationConfig:
         recorded_when_set=True,
         unrecorded=0.0,
     )
+    held_share: float = field(
+        None,
+        "cloning learners with --relabel stop: the share of each behaviour-cloning batch drawn from the held-goal "
+        "pairs (those labelled with the zero action) in the cloning window; they are a few percent of the buffer, "
+        "yet the only pairs that teach standing still beside an object on its goal. A traced setting (0: uniform)",
+        recorded_when_set=True,
+        unrecorded=0.0,
+    )
     learning_rate: float = field(None, "learning rate of the behaviour-cloning step")
     optimiser: str = field(
         None, "behaviour cloning's optimiser: adam or rmsprop (PyTorch's, the authors' code's)",
@@ -157,6 +165,9 @@ class ImitationConfig:
         check(self.batch_size >= 1, "batch_size", self.batch_size, "an integer >= 1")
         check(self.bc_steps >= 1, "bc_steps", self.bc_steps, "an integer >= 1 (no step leaves the loss undefined)")
         check(self.bc_reuse >= 0, "bc_reuse", self.bc_reuse, ">= 0 (0: bc_steps every iteration)")
+        check(0 <= self.held_share < 1, "held_share", self.held_share, "in [0, 1) (0: uniform batches)")
+        allowed = "0 unless --relabel stop (its held pairs are the zero-action ones)"
+        check(self.held_share == 0 or self.relabel == "stop", "held_share", self.held_share, allowed)
         check(self.learning_rate > 0, "learning_rate", self.learning_rate, "> 0")
         check(self.optimiser in OPTIMISERS, "optimiser", self.optimiser, "one of " + ", ".join(OPTIMISERS))
         check(0 <= self.policy_ema < 1, "policy_ema", self.policy_ema, "in [0, 1)")

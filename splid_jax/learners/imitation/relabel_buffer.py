@@ -5,6 +5,8 @@ pairs SELECT accepted."""
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import chex
 import jax
 import jax.numpy as jnp
@@ -52,18 +54,44 @@ def filled(buf: Buffer) -> jax.Array:
     return jnp.arange(buf.capacity) < buf.size
 
 
+class Held(NamedTuple):
+    """The held-goal pairs in the cloning window as a list of slots, made once per epoch of BC steps."""
+
+    slots: jax.Array  # [C] int32, the held pairs' slots first
+    count: jax.Array  # [] int32, how many of ``slots`` are held pairs
+
+
+def held_slots(buf: Buffer, window: jax.Array | int | None = None) -> Held:
+    """The slots of the newest ``window`` pairs (all with None) whose action is zero: the held goals of
+    ``--relabel stop``, which labels them so; an explored action is never exactly zero."""
+    age = (buf.ptr - 1 - jnp.arange(buf.capacity)) % buf.capacity  # 0: the last written
+    inside = filled(buf) if window is None else filled(buf) & (age < window)
+    held = inside & jnp.all(buf.action == 0, axis=-1)
+    slots = jnp.nonzero(held, size=buf.capacity, fill_value=0)[0].astype(jnp.int32)
+    return Held(slots, jnp.sum(held, dtype=jnp.int32))
+
+
 def sample(
     buf: Buffer,
     key: jax.Array,
     batch_size: int,
     window: jax.Array | int | None = None,
+    held: Held | None = None,
+    held_share: jax.Array | float = 0.0,
 ) -> tuple[jax.Array, jax.Array, jax.Array]:
     """Uniform over filled slots (with replacement). An empty buffer yields row 0 of zeros:
     callers weight the loss by ``size > 0``. With ``window``, uniform over the newest ``window`` pairs, as a
-    FIFO buffer of that capacity holds them; while they are all the pairs, the draw is the whole buffer's."""
+    FIFO buffer of that capacity holds them; while they are all the pairs, the draw is the whole buffer's.
+    With ``held``, each row comes from the held pairs instead with probability ``held_share`` (while there are
+    any); the uniform draw uses ``key`` alone, so at share 0 the batch is the uniform one exactly."""
     if window is None:
         idx = jax.random.randint(key, (batch_size,), 0, jnp.maximum(buf.size, 1))
     else:
         drawn = jax.random.randint(key, (batch_size,), 0, jnp.maximum(jnp.minimum(buf.size, window), 1))
         idx = jnp.where(buf.size <= window, drawn, (buf.ptr - 1 - drawn) % buf.capacity)
+    if held is not None:
+        k_pick, k_which = jax.random.split(jax.random.fold_in(key, 1))
+        which = held.slots[jax.random.randint(k_which, (batch_size,), 0, jnp.maximum(held.count, 1))]
+        use = (jax.random.uniform(k_pick, (batch_size,)) < held_share) & (held.count > 0)
+        idx = jnp.where(use, which, idx)
     return buf.obs[idx], buf.goal[idx], buf.action[idx]

@@ -50,6 +50,7 @@ class Hyper:
     gripper_hold: jax.Array  # [] int32, steps the fingers' noise is held (tasks that move them)
     explore_reach: jax.Array  # [] float32, exploration's subgoal reach (inf: the goal itself)
     bc_reuse: jax.Array  # [] float32, BC samples per new pair (0: the configured steps every iteration)
+    held_share: jax.Array  # [] float32, the share of each BC batch drawn from the held (zero-action) pairs
     buffer_window: jax.Array  # [] int32, BC draws from the newest this many pairs (the capacity: all)
     buffer_window_grow: jax.Array  # [] int32, iterations over which the window grows to the capacity (0: fixed)
 
@@ -110,6 +111,7 @@ class Trainer(Chunked):
             gripper_hold=jnp.int32(bc.gripper_hold),
             explore_reach=traced_reach(bc.explore_subgoal_reach),
             bc_reuse=jnp.float32(bc.bc_reuse),
+            held_share=jnp.float32(bc.held_share),
             buffer_window=jnp.int32(bc.buffer_window or self.bc.buffer_size),
             buffer_window_grow=jnp.int32(bc.buffer_window_grow),
         )
@@ -242,6 +244,7 @@ class Trainer(Chunked):
             hyper.acting_step,
             steps,
             hyper.buffer_window,
+            hyper.held_share if bc.relabel == "stop" else None,
         )
 
     def select(self, pstate, traj: Trajectory, horizon: jax.Array) -> Candidates:

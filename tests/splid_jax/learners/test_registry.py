@@ -36,6 +36,7 @@ def test_every_name_builds_its_own_learner_from_its_own_settings():
             value = getattr(cfg, field)
             changed = {field: value + 1 if isinstance(value, int) else value / 2 + 0.1}
             base = dataclasses.replace(cfg, buffer_window=1) if field == "buffer_window_grow" else cfg  # grows from it
+            base = dataclasses.replace(base, relabel="stop") if field == "held_share" else base  # stop's held pairs
             other = dataclasses.replace(base, **changed)
             same = jax.tree.map(lambda a, b: a == b, algo.hyper(other), algo.hyper(base))
             assert not all(jax.tree.leaves(same)), field
@@ -58,7 +59,7 @@ def test_only_the_cloning_learners_split_a_run_and_sweep_their_settings():
     splits = {name for name, x in registry.LEARNERS.items() if x.splits_envs}
     assert splits == {"splid", "gcsl", "pchid"}
     traced = ("sigma", "horizon", "horizon_end", "sigma_end", "learning_rate", "policy_ema", "gripper_hold")
-    traced += ("explore_subgoal_reach", "bc_reuse", "buffer_window", "buffer_window_grow")
+    traced += ("explore_subgoal_reach", "bc_reuse", "held_share", "buffer_window", "buffer_window_grow")
     assert all(registry.get(n).sweeps == (traced if n in splits else ()) for n in registry.names())
     assert [n for n, x in registry.LEARNERS.items() if x.grows_horizon] == ["pchid"]
     assert [n for n, x in registry.LEARNERS.items() if x.clones_every_pair] == ["gcsl"]

@@ -92,3 +92,20 @@ def test_an_epoch_of_active_steps_takes_those_steps_and_leaves_the_rest_as_no_op
     chex.assert_trees_all_close(two[0].params, ps.params, rtol=1e-6, atol=1e-7)
     assert int(two[1][0].count) == 2
     assert abs(float(two[3]) - float(jnp.mean(jnp.stack(losses)))) < 1e-6
+
+
+def test_a_held_share_clones_the_held_pairs_that_much_more():
+    """Every state seen twice, once held (zero action) and once moved (action 1): the held share sets what the
+    policy learns to output there, the uniform draw the pairs' mean."""
+    policy = make_policy(2, 2, 2, (32, 32), normalise=False)
+    pstate = policy.init(jax.random.PRNGKey(0))
+    obs = jax.random.normal(jax.random.PRNGKey(1), (32, 2))
+    obs, goal = jnp.concatenate([obs, obs]), jnp.concatenate([obs, obs])
+    action = jnp.concatenate([jnp.zeros((32, 2)), jnp.ones((32, 2))])
+    buf = relabel_buffer.insert(relabel_buffer.init(64, 2, 2, 2), obs, goal, action, jnp.ones(64, bool))
+    opt = optax.adam(3e-3)
+    epoch = jax.jit(lambda share: bc_epoch(policy, opt, pstate, opt.init(pstate.params), buf, jax.random.PRNGKey(2),
+                                           400, 32, held_share=share)[0])  # fmt: skip
+    mean_action = lambda ps: float(jnp.mean(policy.mean(ps, obs[:32], goal[:32])))  # noqa: E731
+    assert abs(mean_action(epoch(0.0)) - 0.5) < 0.1
+    assert abs(mean_action(epoch(0.6)) - 0.2) < 0.1  # 0.6 + 0.4 / 2 of the draws held

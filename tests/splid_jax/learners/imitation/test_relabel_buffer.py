@@ -64,3 +64,29 @@ def test_a_window_draws_the_newest_pairs_as_a_fifo_of_that_capacity_holds_them()
         )
     part = relabel_buffer.insert(relabel_buffer.init(8, 1, 1, 1), *_rows([1, 2]), jnp.ones(2, bool))
     chex.assert_trees_all_equal(relabel_buffer.sample(part, key, 64, window=3), relabel_buffer.sample(part, key, 64))
+
+
+def test_a_held_share_draws_that_share_from_the_zero_action_pairs_in_the_window():
+    buf = relabel_buffer.init(16, 1, 1, 1)
+    obs = jnp.arange(1.0, 13.0)[:, None]
+    action = jnp.where(jnp.isin(obs, jnp.array([2.0, 9.0, 11.0])), 0.0, 1.0)  # three held pairs
+    buf = relabel_buffer.insert(buf, obs, obs + 100, action, jnp.ones(12, bool))
+    key = jax.random.PRNGKey(3)
+    held = relabel_buffer.held_slots(buf, window=6)  # the newest 6: 7..12, held 9 and 11
+    assert int(held.count) == 2
+    drawn, _, act = relabel_buffer.sample(buf, key, 4000, 6, held, 0.3)
+    drawn = np.asarray(drawn[:, 0])
+    assert set(np.unique(drawn)) <= set(range(7, 13))
+    zero = np.isin(drawn, [9, 11])
+    np.testing.assert_array_equal(np.asarray(act[:, 0]) == 0, zero)
+    assert 0.3 + 2 / 6 * 0.7 - 0.04 < zero.mean() < 0.3 + 2 / 6 * 0.7 + 0.04
+    # share 0 leaves the uniform batch exactly
+    chex.assert_trees_all_equal(
+        relabel_buffer.sample(buf, key, 64, 6, held, 0.0), relabel_buffer.sample(buf, key, 64, 6)
+    )
+    # no held pair in the window: the uniform batch
+    none = relabel_buffer.held_slots(buf, window=1)
+    assert int(none.count) == 0
+    chex.assert_trees_all_equal(
+        relabel_buffer.sample(buf, key, 64, 1, none, 0.5), relabel_buffer.sample(buf, key, 64, 1)
+    )
