@@ -32,7 +32,7 @@ MAX_ITERATIONS = 10**7  # far beyond any run's budget: a larger value is a typo,
 PROVENANCE = ("devices", "physics")
 # Settings runs were once recorded with that left the package (experiments/NOTES.md, "Retired options"): a
 # config.json holding one at its neutral value loads without it, one at another value is refused
-RETIRED = {"hold_horizon": 0, "rest_horizon": 0, "select_radius": 1.0, "held_share": 0.0}
+RETIRED = {"hold_horizon": 0, "rest_horizon": 0, "select_radius": 1.0}
 
 
 _KINDS = {

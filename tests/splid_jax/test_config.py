@@ -247,8 +247,10 @@ def test_an_old_config_json_loads_and_resumes_as_it_ran(tmp_path):
     resumed, is_resume = config_from_cli(build_parser().parse_args(["--resume", str(run), "--iterations", "10"]))
     assert is_resume and resumed == dataclasses.replace(now, iterations=10, run_dir=str(run))
     for name, value in (("select_radius", 0.8), ("relabel", "settle"), ("held_share", 0.1)):
-        with pytest.raises(InvalidConfig, match=name):
+        with pytest.raises(InvalidConfig, match=name):  # held_share: only stop's held pairs are zero-action ones
             TrainConfig.from_json({**OLD_CONFIG, name: value})
+    stop = TrainConfig.from_json({**OLD_CONFIG, "relabel": "stop", "held_share": 0.1})
+    assert stop.held_share == 0.1 and identity(stop)["held_share"] == 0.1  # read back as it ran, and recorded
 
 
 def test_a_her_run_recorded_before_mrls_defaults_reads_its_options_against_baselines_and_resumes():
