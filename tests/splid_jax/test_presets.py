@@ -12,7 +12,7 @@ from splid_jax import presets
 from splid_jax.common.errors import InvalidConfig
 from splid_jax.config import TrainConfig
 from splid_jax.learners.her.config import BASELINES, HerConfig
-from splid_jax.learners.imitation.config import RELABELS
+from splid_jax.learners.imitation.config import RELABELS, STANDING_STILL
 from splid_jax.learners.splid import relabel
 
 # The paper preset as the paper (section 4.1, Algorithm 2) and the authors' code (decisionforce/ESPD) give it
@@ -104,6 +104,7 @@ def test_the_paper_preset_clones_with_rmsprop():
 
 def test_the_relabellings_named_in_the_config_are_selects_strategies():
     assert RELABELS == relabel.NAMES and relabel.HOLDING == ("hold", "stop", "exact")
+    assert STANDING_STILL == tuple(name for name, s in relabel.STRATEGIES.items() if s.stands_still)
     fields = {f.name for f in TrainConfig.settings_fields()}
     assert not fields & {"hold_horizon", "rest_horizon", "select_radius"}  # retired
 

@@ -11,6 +11,7 @@ from splid_jax.common.errors import check
 from splid_jax.common.fields import field
 
 RELABELS = ("paper", "hold", "stop", "exact")  # splid.relabel.STRATEGIES, named here without importing JAX
+STANDING_STILL = ("stop",)  # whose held pairs carry the zero action (Strategy.stands_still): held_share finds them
 GCSL_RELABELS = ("final", "future")
 OPTIMISERS = ("adam", "rmsprop")
 
@@ -166,8 +167,8 @@ class ImitationConfig:
         check(self.bc_steps >= 1, "bc_steps", self.bc_steps, "an integer >= 1 (no step leaves the loss undefined)")
         check(self.bc_reuse >= 0, "bc_reuse", self.bc_reuse, ">= 0 (0: bc_steps every iteration)")
         check(0 <= self.held_share < 1, "held_share", self.held_share, "in [0, 1) (0: uniform batches)")
-        allowed = "0 unless --relabel stop (its held pairs are the zero-action ones)"
-        check(self.held_share == 0 or self.relabel == "stop", "held_share", self.held_share, allowed)
+        allowed = f"0 unless --relabel {' or '.join(STANDING_STILL)} (its held pairs are the zero-action ones)"
+        check(self.held_share == 0 or self.relabel in STANDING_STILL, "held_share", self.held_share, allowed)
         check(self.learning_rate > 0, "learning_rate", self.learning_rate, "> 0")
         check(self.optimiser in OPTIMISERS, "optimiser", self.optimiser, "one of " + ", ".join(OPTIMISERS))
         check(0 <= self.policy_ema < 1, "policy_ema", self.policy_ema, "in [0, 1)")

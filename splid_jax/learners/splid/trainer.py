@@ -23,6 +23,7 @@ from splid_jax.learners.imitation.bc import bc_epoch
 from splid_jax.learners.imitation.candidates import Candidates
 from splid_jax.learners.imitation.config import ImitationConfig
 from splid_jax.learners.imitation.explore import Seen, Trajectory, draws, hold_fingers, rollout
+from splid_jax.learners.splid.relabel import STRATEGIES
 from splid_jax.learners.splid.select import select
 
 
@@ -244,7 +245,7 @@ class Trainer(Chunked):
             hyper.acting_step,
             steps,
             hyper.buffer_window,
-            hyper.held_share if bc.relabel == "stop" else None,
+            hyper.held_share if STRATEGIES[bc.relabel].stands_still else None,  # held pairs found by their zero action
         )
 
     def select(self, pstate, traj: Trajectory, horizon: jax.Array) -> Candidates:
