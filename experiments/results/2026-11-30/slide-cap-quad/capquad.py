@@ -7,7 +7,8 @@ SIDES, MAXV = 16, 24
 
 
 def _area4(a, b, c, d):
-    v = jnp.cross(jnp.append(d - a, 0.0), jnp.append(b - d, 0.0)) + jnp.cross(jnp.append(c - b, 0.0), jnp.append(a - c, 0.0))
+    lift = lambda v: jnp.append(v, 0.0)  # noqa: E731
+    v = jnp.cross(lift(d - a), lift(b - d)) + jnp.cross(lift(c - b), lift(a - c))
     return 0.5 * jnp.abs(v[2])
 
 
