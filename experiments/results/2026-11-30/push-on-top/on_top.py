@@ -12,11 +12,16 @@ import sys
 import numpy as np
 
 
+def grip_on_top(grip: np.ndarray, cube: np.ndarray) -> np.ndarray:
+    """Whether the grip site [..., 3] rests on the cube's [..., 3] top face, over any leading axes."""
+    dz = grip[..., 2] - cube[..., 2]
+    across = np.linalg.norm(grip[..., 0:2] - cube[..., 0:2], axis=-1)
+    return (dz > 0.03) & (dz < 0.055) & (across < 0.05)
+
+
 def on_top(obs: np.ndarray) -> np.ndarray:
     """[episodes, steps] bool from observations [episodes, steps, 25] (grip 0:3, cube 3:6)."""
-    dz = obs[:, :, 2] - obs[:, :, 5]
-    across = np.linalg.norm(obs[:, :, 0:2] - obs[:, :, 3:5], axis=-1)
-    return (dz > 0.03) & (dz < 0.055) & (across < 0.05)
+    return grip_on_top(obs[..., 0:3], obs[..., 3:6])
 
 
 def stays(on: np.ndarray) -> list[int]:

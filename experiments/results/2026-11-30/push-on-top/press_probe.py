@@ -13,11 +13,16 @@ import argparse
 import json
 import os
 import sys
+from collections.abc import Callable
+from typing import NamedTuple
 
 import mujoco
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", ".."))
+sys.path.insert(0, os.path.dirname(__file__))
+
+from on_top import grip_on_top  # noqa: E402
 
 from envs.fetch import control, models  # noqa: E402
 from splid_jax.reference.extra import make_reference  # noqa: E402
@@ -27,27 +32,52 @@ HEADINGS = np.arange(8) * np.pi / 4
 ACROSS = (0.02, 0.03, 0.035, 0.04, 0.045)
 
 
-def on_top(grip, cube) -> bool:
-    dz, across = grip[2] - cube[2], np.linalg.norm(grip[:2] - cube[:2])
-    return 0.03 < dz < 0.055 and across < 0.05
+class OurPush(NamedTuple):
+    """Our Push model in MuJoCo C, driven by our control rule."""
+
+    m: mujoco.MjModel
+    d: mujoco.MjData
+    home: np.ndarray  # the grip site when the gripper joints are 0
+    grip_q: int  # qpos address of the gripper's x slide
+    object_q: int  # qpos address of the cube's free joint
+    rest: float  # the cube's centre height at rest
+    step: Callable[[np.ndarray], None]  # one control step at action xyz
+
+
+def our_push(drive: str = "pd", gripper_mass: float | None = None) -> OurPush:
+    xml = models.mjcf("push", timestep=0.004, finger="pads", finger_table=1.0, drive=drive, gripper_mass=gripper_mass)
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    lo, hi = models.workspace_box("push", 1.0)
+    home = m.body("gripper").pos.copy()
+    g, o = m.joint("grip_x").qposadr[0], m.joint("object").qposadr[0]
+    mujoco.mj_forward(m, d)
+
+    def step(a):
+        d.ctrl[0:3] = control.gripper_target(d.qpos[g : g + 3].copy(), np.asarray(a), home, lo, hi,
+                                            control.ARM_REACH_CENTER_DEFAULT)  # fmt: skip
+        if drive == "weld":  # the constraint pulls the gripper to the mocap body, put at the target
+            d.mocap_pos[0] = home + d.ctrl[0:3]
+        for _ in range(SUBSTEPS):
+            mujoco.mj_step(m, d)
+
+    return OurPush(m, d, home, g, o, models.rest_height(m, o), step)
 
 
 def stay(trace) -> int:
     n = 0
     for grip, cube in trace:
-        if not on_top(grip, cube):
+        if not grip_on_top(grip, cube):
             break
         n += 1
     return n
 
 
-def reference_case(env, heading, across, press, tweak=None):
+def reference_case(env, heading, across, press):
     from gymnasium_robotics.utils import mujoco_utils
 
     env.reset(seed=0)
     u = env.unwrapped
-    if tweak:
-        tweak(u.model)
     for _ in range(LIFT):
         o, *_ = env.step(np.array([0.0, 0.0, 0.6, 0.0]))
     grip = o["observation"][:3]
@@ -65,35 +95,20 @@ def reference_case(env, heading, across, press, tweak=None):
 
 
 def our_case(heading, across, press, drive="pd", gripper_mass=None):
-    xml = models.mjcf("push", timestep=0.004, finger="pads", finger_table=1.0, drive=drive, gripper_mass=gripper_mass)
-    m = mujoco.MjModel.from_xml_string(xml)
-    d = mujoco.MjData(m)
-    lo, hi = models.workspace_box("push", 1.0)
-    home = m.body("gripper").pos.copy()
-    g, o = m.joint("grip_x").qposadr[0], m.joint("object").qposadr[0]
-    rest = models.rest_height(m, o)
-    mujoco.mj_forward(m, d)
-
-    def step(a):
-        d.ctrl[0:3] = control.gripper_target(d.qpos[g : g + 3].copy(), np.asarray(a), home, lo, hi,
-                                            control.ARM_REACH_CENTER_DEFAULT)  # fmt: skip
-        if drive == "weld":
-            d.mocap_pos[0] = home + d.ctrl[0:3]
-        for _ in range(SUBSTEPS):
-            mujoco.mj_step(m, d)
-
-    d.qpos[o : o + 7] = [home[0] + 0.3, home[1] + 0.3, rest, 1, 0, 0, 0]
+    p = our_push(drive, gripper_mass)
+    m, d, g, o = p.m, p.d, p.grip_q, p.object_q
+    d.qpos[o : o + 7] = [p.home[0] + 0.3, p.home[1] + 0.3, p.rest, 1, 0, 0, 0]
     for _ in range(LIFT):
-        step([0.0, 0.0, 0.6])
-    grip = home + d.qpos[g : g + 3]
+        p.step([0.0, 0.0, 0.6])
+    grip = p.home + d.qpos[g : g + 3]
     xy = grip[:2] - across * np.array([np.cos(heading), np.sin(heading)])
-    d.qpos[o : o + 7] = [*xy, rest, 1, 0, 0, 0]
+    d.qpos[o : o + 7] = [*xy, p.rest, 1, 0, 0, 0]
     d.qvel[m.joint("object").dofadr[0] : m.joint("object").dofadr[0] + 6] = 0
     mujoco.mj_forward(m, d)
     trace = []
     for _ in range(STEPS):
-        step([0.0, 0.0, -press])
-        trace.append((home + d.qpos[g : g + 3], d.qpos[o : o + 3].copy()))
+        p.step([0.0, 0.0, -press])
+        trace.append((p.home + d.qpos[g : g + 3], d.qpos[o : o + 3].copy()))
     return stay(trace), float(np.linalg.norm(trace[-1][1][:2] - xy))
 
 

@@ -17,36 +17,26 @@ import numpy as np
 ROOT = os.path.join(os.path.dirname(__file__), "..", "..", "..", "..")
 sys.path.insert(0, ROOT)
 sys.path.insert(0, os.path.join(ROOT, "experiments", "reference"))
+sys.path.insert(0, os.path.dirname(__file__))
 
 import push_contact as pc  # noqa: E402
+from press_probe import our_push  # noqa: E402
 
-from envs.fetch import control, models  # noqa: E402
+from envs.fetch import models  # noqa: E402
 
 
 def our_pushes(drive: str, gripper_mass: float | None) -> np.ndarray:
-    xml = models.mjcf("push", timestep=0.004, finger="pads", finger_table=1.0, drive=drive, gripper_mass=gripper_mass)
-    m = mujoco.MjModel.from_xml_string(xml)
-    d = mujoco.MjData(m)
-    lo, hi = models.workspace_box("push", 1.0)
-    home = m.body("gripper").pos.copy()
-    g, o = m.joint("grip_x").qposadr[0], m.joint("object").qposadr[0]
-    rest = models.rest_height(m, o)
+    p = our_push(drive, gripper_mass)
+    m, d, o = p.m, p.d, p.object_q
     out = []
     for angle, side, speed in pc.CASES:
         mujoco.mj_resetData(m, d)
-        xy, ahead = pc._start(home[:2], angle, side)
-        d.qpos[o : o + 7] = [*xy, rest, 1.0, 0.0, 0.0, 0.0]
+        xy, ahead = pc._start(p.home[:2], angle, side)
+        d.qpos[o : o + 7] = [*xy, p.rest, 1.0, 0.0, 0.0, 0.0]
         mujoco.mj_forward(m, d)
-        if drive == "weld":
-            d.mocap_pos[0] = home
         for t in range(pc.HOLD + pc.RELEASE):
             a = speed * ahead if t < pc.HOLD else np.zeros(2)
-            d.ctrl[0:3] = control.gripper_target(d.qpos[g : g + 3].copy(), np.array([*a, 0.0]), home, lo, hi,
-                                                control.ARM_REACH_CENTER_DEFAULT)  # fmt: skip
-            if drive == "weld":
-                d.mocap_pos[0] = home + d.ctrl[0:3]
-            for _ in range(pc.SUBSTEPS):
-                mujoco.mj_step(m, d)
+            p.step(np.array([*a, 0.0]))
         out.append([*(d.qpos[o : o + 2] - xy), pc._yaw(d.qpos[o + 3 : o + 7])])
     return np.array(out)
 
